@@ -1,0 +1,586 @@
+//! Writes meshlight's gallery scene as OBJ: four 12 m × 7.9 m rooms under one 4.5 m ceiling,
+//! joined by doorways in solid partition walls 0.2 m thick, with pedestals carrying faceted
+//! sculptures, framed paintings on the outer walls, benches, and 8 point lights under the
+//! ceiling (in `scene.toml`). Floors and outer walls are tiled (`tile`, default 0.1 m), as
+//! architectural exports often are, which gives ≥ 100k triangles mixing huge ceiling triangles
+//! with small ones. The OBJ is generated rather than committed (several MB).
+//!
+//! Every solid (partition walls, pedestals, frames, benches, sculptures) faces outwards; the
+//! rooms' floor, ceiling and outer walls face inwards. No faces hide inside solids: tiles under
+//! partition walls and wall faces behind junctions are left out.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// Settings of the generated geometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GalleryOptions {
+    /// Side of the floor and outer-wall tiles, metres (a multiple of 0.1 divides 0.1 evenly:
+    /// use 0.1, 0.05, ... or 0.2 for a lighter mesh).
+    pub tile: f64,
+    /// Subdivision level of the icosphere sculptures (0 = icosahedron).
+    pub sphere_detail: u32,
+}
+
+impl Default for GalleryOptions {
+    fn default() -> Self {
+        GalleryOptions {
+            tile: 0.1,
+            sphere_detail: 2,
+        }
+    }
+}
+
+/// Building size, metres.
+const WIDTH: f64 = 24.0;
+const DEPTH: f64 = 16.0;
+const HEIGHT: f64 = 4.5;
+/// Partition walls: one along x at z = 8, one along z at x = 12.
+const WALL: f64 = 0.2;
+const DOOR_WIDTH: f64 = 1.6;
+const DOOR_HEIGHT: f64 = 2.6;
+
+/// What was written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stats {
+    /// Vertices written.
+    pub vertices: usize,
+    /// Triangles, counting each quad as two (as the loader fan-triangulates them).
+    pub triangles: usize,
+}
+
+type P = [f64; 3];
+
+/// An OBJ under construction: deduplicated vertices, faces grouped by material.
+#[derive(Default)]
+struct Obj {
+    vertices: Vec<P>,
+    index: HashMap<[i64; 3], usize>,
+    faces: Vec<(String, Vec<usize>)>,
+    triangles: usize,
+}
+
+impl Obj {
+    fn vertex(&mut self, p: P) -> usize {
+        let key = p.map(|x| (x * 1e6).round() as i64);
+        let next = self.vertices.len() + 1;
+        *self.index.entry(key).or_insert_with(|| {
+            self.vertices.push(p);
+            next
+        })
+    }
+
+    /// A planar polygon, wound so that its front faces along `normal`.
+    fn polygon(&mut self, material: &str, mut corners: Vec<P>, normal: P) {
+        let (a, b, c) = (corners[0], corners[1], corners[2]);
+        let e1 = sub(b, a);
+        let e2 = sub(c, a);
+        let cross = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        if dot(cross, normal) < 0.0 {
+            corners.reverse();
+        }
+        self.triangles += corners.len() - 2;
+        let ids = corners.into_iter().map(|p| self.vertex(p)).collect();
+        self.faces.push((material.to_string(), ids));
+    }
+
+    /// An axis-aligned rectangle spanned by two axes from `origin`, facing `normal`.
+    fn rect(&mut self, material: &str, origin: P, u: P, v: P, normal: P) {
+        let corners = vec![
+            origin,
+            add(origin, u),
+            add(add(origin, u), v),
+            add(origin, v),
+        ];
+        self.polygon(material, corners, normal);
+    }
+
+    fn write(&self, header: &str) -> String {
+        let mut s = String::with_capacity(self.vertices.len() * 30 + self.faces.len() * 24);
+        s.push_str(header);
+        s.push_str("mtllib gallery.mtl\n");
+        for v in &self.vertices {
+            let _ = writeln!(s, "v {} {} {}", num(v[0]), num(v[1]), num(v[2]));
+        }
+        let mut current = "";
+        for (material, ids) in &self.faces {
+            if material != current {
+                let _ = writeln!(s, "usemtl {material}");
+                current = material;
+            }
+            s.push('f');
+            for id in ids {
+                let _ = write!(s, " {id}");
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
+
+fn num(x: f64) -> String {
+    let r = (x * 1e6).round() / 1e6;
+    if r == 0.0 {
+        "0".into()
+    } else {
+        format!("{r}")
+    }
+}
+
+fn add(a: P, b: P) -> P {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn sub(a: P, b: P) -> P {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: P, b: P) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn scale(a: P, s: f64) -> P {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+fn normalize(a: P) -> P {
+    scale(a, 1.0 / dot(a, a).sqrt())
+}
+
+/// The two partition walls as footprints: (x0, x1, z0, z1).
+const WALL_A: (f64, f64, f64, f64) = (0.0, WIDTH, 8.0 - WALL / 2.0, 8.0 + WALL / 2.0);
+const WALL_B: (f64, f64, f64, f64) = (12.0 - WALL / 2.0, 12.0 + WALL / 2.0, 0.0, DEPTH);
+/// Doorways: in wall A (ranges of x) and in wall B (ranges of z).
+const DOORS_A: [(f64, f64); 2] = [(5.0, 5.0 + DOOR_WIDTH), (17.4, 17.4 + DOOR_WIDTH)];
+const DOORS_B: [(f64, f64); 2] = [(3.2, 3.2 + DOOR_WIDTH), (11.2, 11.2 + DOOR_WIDTH)];
+
+/// Whether floor point (x, z) lies under a partition wall (outside the doorways).
+fn under_wall(x: f64, z: f64) -> bool {
+    let in_a = z > WALL_A.2 && z < WALL_A.3 && !DOORS_A.iter().any(|&(a, b)| x > a && x < b);
+    let in_b = x > WALL_B.0 && x < WALL_B.1 && !DOORS_B.iter().any(|&(a, b)| z > a && z < b);
+    in_a || in_b
+}
+
+/// One straight partition-wall segment: from `start` along unit axis `along` for `length`,
+/// thickness across `across` (centred), with doorways at offsets along it. Emits the two long
+/// faces (split around doors), and each door's jambs and soffit; no ends (they abut other walls).
+fn partition(obj: &mut Obj, start: P, along: P, length: f64, across: P, doors: &[(f64, f64)]) {
+    let up = [0.0, 1.0, 0.0];
+    let half = scale(across, WALL / 2.0);
+    for side in [1.0, -1.0] {
+        let normal = scale(across, side);
+        let face_origin = add(start, scale(half, side));
+        let mut u = 0.0;
+        for &(d0, d1) in doors.iter().chain(std::iter::once(&(length, length))) {
+            if d0 > u {
+                obj.rect(
+                    "wall",
+                    add(face_origin, scale(along, u)),
+                    scale(along, d0 - u),
+                    scale(up, HEIGHT),
+                    normal,
+                );
+            }
+            if d1 > d0 {
+                let lintel = add(add(face_origin, scale(along, d0)), scale(up, DOOR_HEIGHT));
+                obj.rect(
+                    "wall",
+                    lintel,
+                    scale(along, d1 - d0),
+                    scale(up, HEIGHT - DOOR_HEIGHT),
+                    normal,
+                );
+            }
+            u = d1;
+        }
+    }
+    for &(d0, d1) in doors {
+        let back = sub(start, half);
+        let thick = scale(across, WALL);
+        let jamb0 = add(back, scale(along, d0));
+        obj.rect("wall", jamb0, thick, scale(up, DOOR_HEIGHT), along);
+        let jamb1 = add(back, scale(along, d1));
+        obj.rect(
+            "wall",
+            jamb1,
+            thick,
+            scale(up, DOOR_HEIGHT),
+            scale(along, -1.0),
+        );
+        let soffit = add(add(back, scale(along, d0)), scale(up, DOOR_HEIGHT));
+        obj.rect(
+            "wall",
+            soffit,
+            thick,
+            scale(along, d1 - d0),
+            [0.0, -1.0, 0.0],
+        );
+    }
+}
+
+/// An axis-aligned box from `min` to `max`; `bottom` says whether to emit its underside.
+fn block(obj: &mut Obj, material: &str, min: P, max: P, bottom: bool) {
+    let d = sub(max, min);
+    let (x, y, z) = ([d[0], 0.0, 0.0], [0.0, d[1], 0.0], [0.0, 0.0, d[2]]);
+    obj.rect(material, [min[0], max[1], min[2]], x, z, [0.0, 1.0, 0.0]);
+    if bottom {
+        obj.rect(material, min, x, z, [0.0, -1.0, 0.0]);
+    }
+    obj.rect(material, min, x, y, [0.0, 0.0, -1.0]);
+    obj.rect(material, [min[0], min[1], max[2]], x, y, [0.0, 0.0, 1.0]);
+    obj.rect(material, min, z, y, [-1.0, 0.0, 0.0]);
+    obj.rect(material, [max[0], min[1], min[2]], z, y, [1.0, 0.0, 0.0]);
+}
+
+/// A faceted icosphere (flat facets: each is one planar surface for the solver).
+fn icosphere(obj: &mut Obj, material: &str, centre: P, radius: f64, detail: u32) {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<P> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|&p| normalize(p))
+    .collect();
+    let mut faces: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..detail {
+        let mut midpoints: HashMap<(usize, usize), usize> = HashMap::new();
+        let mut mid = |a: usize, b: usize, v: &mut Vec<P>| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push(normalize(scale(add(v[a], v[b]), 0.5)));
+                v.len() - 1
+            })
+        };
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        for [a, b, c] in faces {
+            let (ab, bc, ca) = (mid(a, b, &mut v), mid(b, c, &mut v), mid(c, a, &mut v));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    for f in faces {
+        let corners: Vec<P> = f
+            .iter()
+            .map(|&i| add(centre, scale(v[i], radius)))
+            .collect();
+        let c = scale(add(add(v[f[0]], v[f[1]]), v[f[2]]), 1.0 / 3.0);
+        obj.polygon(material, corners, c);
+    }
+}
+
+/// A framed painting on a wall: canvas 2 cm off the wall, a frame of four bars around it.
+/// `origin` is the canvas's lower-left corner on the wall plane, `right` and `normal` unit axes.
+fn painting(obj: &mut Obj, canvas: &str, origin: P, right: P, normal: P, w: f64, h: f64) {
+    let up = [0.0, 1.0, 0.0];
+    let at = |u: f64, v: f64| add(add(origin, scale(right, u)), scale(up, v));
+    obj.rect(
+        canvas,
+        add(at(0.0, 0.0), scale(normal, 0.02)),
+        scale(right, w),
+        scale(up, h),
+        normal,
+    );
+    let (bar, depth) = (0.07, 0.05);
+    let dn = scale(normal, depth);
+    // Bottom and top bars span the full width; the side bars fit between them, so their ends
+    // (which would touch the other bars face to face) are left out.
+    let bars = [
+        (-bar, -bar, w + 2.0 * bar, bar, true),
+        (-bar, h, w + 2.0 * bar, bar, true),
+        (-bar, 0.0, bar, h, false),
+        (w, 0.0, bar, h, false),
+    ];
+    for (u, v, a, b, horizontal) in bars {
+        let corner = at(u, v);
+        let (ua, ub) = (scale(right, a), scale(up, b));
+        obj.rect("frame", add(corner, dn), ua, ub, normal);
+        if horizontal {
+            obj.rect("frame", corner, ua, dn, scale(up, -1.0));
+            obj.rect("frame", add(corner, ub), ua, dn, up);
+        }
+        obj.rect("frame", corner, ub, dn, scale(right, -1.0));
+        obj.rect("frame", add(corner, ua), ub, dn, right);
+    }
+}
+
+/// Builds the whole gallery.
+fn build(options: GalleryOptions) -> Obj {
+    let mut obj = Obj::default();
+    let tile = options.tile;
+
+    // Floor: tiles, none under the partition walls (doorways keep theirs).
+    let (nx, nz) = (
+        (WIDTH / tile).round() as usize,
+        (DEPTH / tile).round() as usize,
+    );
+    for i in 0..nx {
+        for k in 0..nz {
+            let (x, z) = (i as f64 * tile, k as f64 * tile);
+            if !under_wall(x + tile / 2.0, z + tile / 2.0) {
+                obj.rect(
+                    "floor",
+                    [x, 0.0, z],
+                    [tile, 0.0, 0.0],
+                    [0.0, 0.0, tile],
+                    [0.0, 1.0, 0.0],
+                );
+            }
+        }
+    }
+    // Ceiling: one large quad per room (huge triangles beside the small ones).
+    for (x0, x1) in [(0.0, WALL_B.0), (WALL_B.1, WIDTH)] {
+        for (z0, z1) in [(0.0, WALL_A.2), (WALL_A.3, DEPTH)] {
+            obj.rect(
+                "ceiling",
+                [x0, HEIGHT, z0],
+                [x1 - x0, 0.0, 0.0],
+                [0.0, 0.0, z1 - z0],
+                [0.0, -1.0, 0.0],
+            );
+        }
+    }
+    // Outer walls, tiled, facing in; no tiles behind the partition walls' ends.
+    let ny = (HEIGHT / tile).round() as usize;
+    let walls: [(P, P, f64, P); 4] = [
+        ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], WIDTH, [0.0, 0.0, 1.0]),
+        ([0.0, 0.0, DEPTH], [1.0, 0.0, 0.0], WIDTH, [0.0, 0.0, -1.0]),
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], DEPTH, [1.0, 0.0, 0.0]),
+        ([WIDTH, 0.0, 0.0], [0.0, 0.0, 1.0], DEPTH, [-1.0, 0.0, 0.0]),
+    ];
+    for (origin, along, length, normal) in walls {
+        let n = (length / tile).round() as usize;
+        for i in 0..n {
+            let u = (i as f64 + 0.5) * tile;
+            let mid = add(origin, scale(along, u));
+            let behind_partition = (mid[0] > WALL_B.0 && mid[0] < WALL_B.1)
+                || (mid[2] > WALL_A.2 && mid[2] < WALL_A.3);
+            if behind_partition {
+                continue;
+            }
+            for j in 0..ny {
+                let o = add(
+                    add(origin, scale(along, i as f64 * tile)),
+                    [0.0, j as f64 * tile, 0.0],
+                );
+                obj.rect("wall", o, scale(along, tile), [0.0, tile, 0.0], normal);
+            }
+        }
+    }
+    // Partition walls: A along x in two segments around the junction, B along z likewise.
+    let (a_z, b_x) = (8.0, 12.0);
+    let shift = |doors: [(f64, f64); 2], by: f64| doors.map(|(a, b)| (a - by, b - by));
+    partition(
+        &mut obj,
+        [0.0, 0.0, a_z],
+        [1.0, 0.0, 0.0],
+        WALL_B.0,
+        [0.0, 0.0, 1.0],
+        &DOORS_A[..1],
+    );
+    partition(
+        &mut obj,
+        [WALL_B.1, 0.0, a_z],
+        [1.0, 0.0, 0.0],
+        WIDTH - WALL_B.1,
+        [0.0, 0.0, 1.0],
+        &shift(DOORS_A, WALL_B.1)[1..],
+    );
+    partition(
+        &mut obj,
+        [b_x, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        WALL_A.2,
+        [1.0, 0.0, 0.0],
+        &DOORS_B[..1],
+    );
+    partition(
+        &mut obj,
+        [b_x, 0.0, WALL_A.3],
+        [0.0, 0.0, 1.0],
+        DEPTH - WALL_A.3,
+        [1.0, 0.0, 0.0],
+        &shift(DOORS_B, WALL_A.3)[1..],
+    );
+
+    // Per room: two pedestals with sculptures, a bench, paintings on its two outer walls.
+    let canvases = ["canvas_red", "canvas_blue", "canvas_ochre", "canvas_teal"];
+    let rooms = [
+        (0.0, 0.0),
+        (WALL_B.1, 0.0),
+        (0.0, WALL_A.3),
+        (WALL_B.1, WALL_A.3),
+    ];
+    for (r, &(rx, rz)) in rooms.iter().enumerate() {
+        let (w, d) = (WALL_B.0, WALL_A.2);
+        for (p, &(fx, fz)) in [(0.3, 0.35), (0.7, 0.65)].iter().enumerate() {
+            let (cx, cz) = (rx + fx * w, rz + fz * d);
+            block(
+                &mut obj,
+                "pedestal",
+                [cx - 0.3, 0.0, cz - 0.3],
+                [cx + 0.3, 1.0, cz + 0.3],
+                false,
+            );
+            let detail = if p == 0 {
+                options.sphere_detail
+            } else {
+                options.sphere_detail.saturating_sub(1)
+            };
+            icosphere(&mut obj, "stone", [cx, 1.0 + 0.32, cz], 0.32, detail);
+        }
+        let (bx, bz) = (rx + 0.5 * w, rz + 0.5 * d);
+        block(
+            &mut obj,
+            "bench",
+            [bx - 0.8, 0.0, bz - 0.2],
+            [bx + 0.8, 0.45, bz + 0.2],
+            false,
+        );
+        // The room's outer walls: z = 0 or DEPTH, and x = 0 or WIDTH.
+        let z_wall = if rz == 0.0 {
+            (0.0, [0.0, 0.0, 1.0])
+        } else {
+            (DEPTH, [0.0, 0.0, -1.0])
+        };
+        let x_wall = if rx == 0.0 {
+            (0.0, [1.0, 0.0, 0.0])
+        } else {
+            (WIDTH, [-1.0, 0.0, 0.0])
+        };
+        for i in 0..3 {
+            let canvas = canvases[(r + i) % canvases.len()];
+            let x = rx + 1.8 + i as f64 * 3.4;
+            painting(
+                &mut obj,
+                canvas,
+                [x, 1.3, z_wall.0],
+                [1.0, 0.0, 0.0],
+                z_wall.1,
+                1.6,
+                1.1,
+            );
+        }
+        for i in 0..2 {
+            let canvas = canvases[(r + i + 1) % canvases.len()];
+            let z = rz + 1.6 + i as f64 * 3.2;
+            painting(
+                &mut obj,
+                canvas,
+                [x_wall.0, 1.3, z],
+                [0.0, 0.0, 1.0],
+                x_wall.1,
+                1.4,
+                1.0,
+            );
+        }
+    }
+    obj
+}
+
+/// The first line of a generated OBJ: identifies the generator version and options, so a stale
+/// file is regenerated.
+pub fn header(options: GalleryOptions) -> String {
+    format!(
+        "# meshlight gallery v1 tile={} sphere_detail={}\n",
+        options.tile, options.sphere_detail
+    )
+}
+
+/// Writes `gallery.obj` into `dir` (atomically: a temporary file renamed into place, so
+/// concurrent writers never leave a torn file).
+pub fn write_obj(dir: &Path, options: GalleryOptions) -> io::Result<Stats> {
+    let obj = build(options);
+    let text = obj.write(&header(options));
+    let path = dir.join("gallery.obj");
+    let tmp = dir.join(format!("gallery.obj.{}.tmp", std::process::id()));
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, &path)?;
+    Ok(Stats {
+        vertices: obj.vertices.len(),
+        triangles: obj.triangles,
+    })
+}
+
+/// This crate's own folder: `scenes/gallery`, where `scene.toml` and `gallery.mtl` live.
+pub fn shipped_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Makes sure the shipped gallery's OBJ exists with the default options, writing it if it is
+/// missing or stale; returns the path of `scene.toml`.
+pub fn ensure() -> io::Result<PathBuf> {
+    let dir = shipped_dir();
+    let obj = dir.join("gallery.obj");
+    let expected = header(GalleryOptions::default());
+    let current = std::fs::read(&obj).ok().and_then(|bytes| {
+        let end = bytes.iter().position(|&b| b == b'\n')? + 1;
+        String::from_utf8(bytes[..end].to_vec()).ok()
+    });
+    if current.as_deref() != Some(expected.as_str()) {
+        write_obj(&dir, GalleryOptions::default())?;
+    }
+    Ok(dir.join("scene.toml"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_gallery_has_at_least_100k_triangles() {
+        let obj = build(GalleryOptions::default());
+        assert!(obj.triangles >= 100_000, "{} triangles", obj.triangles);
+    }
+
+    #[test]
+    fn icosphere_facets_face_outwards() {
+        let mut obj = Obj::default();
+        icosphere(&mut obj, "stone", [1.0, 2.0, 3.0], 0.5, 1);
+        assert_eq!(obj.triangles, 80);
+        for (_, ids) in &obj.faces {
+            let [a, b, c] = [ids[0], ids[1], ids[2]].map(|i| obj.vertices[i - 1]);
+            let n = {
+                let (e1, e2) = (sub(b, a), sub(c, a));
+                [
+                    e1[1] * e2[2] - e1[2] * e2[1],
+                    e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0],
+                ]
+            };
+            assert!(dot(n, sub(a, [1.0, 2.0, 3.0])) > 0.0);
+        }
+    }
+}

@@ -1,0 +1,268 @@
+//! The scene: triangles grouped into planar surfaces, diffuse materials, area and point lights,
+//! and a camera, loaded from a scene file (TOML + OBJ/MTL, `shared/spec/scene-format.md`) or
+//! built from parts by a host program.
+
+mod camera;
+mod file;
+mod obj;
+mod surfaces;
+mod validate;
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::{DVec3, Vec3};
+
+use crate::error::{Error, Result};
+pub use camera::Camera;
+
+/// A diffuse material: reflectance and emitted radiance, RGB.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// The material's name (from `newmtl`).
+    pub name: String,
+    /// Diffuse reflectance, each channel in [0, 1).
+    pub kd: Vec3,
+    /// Emitted radiance of a Lambertian emitter (W·sr⁻¹·m⁻²); non-zero makes an area light.
+    pub ke: Vec3,
+}
+
+impl Material {
+    /// Whether faces of this material emit light.
+    pub fn is_emitter(&self) -> bool {
+        self.ke.max_element() > 0.0
+    }
+}
+
+/// A triangle of the scene, after degenerate ones were dropped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Corners, counter-clockwise seen from the front.
+    pub vertices: [Vec3; 3],
+    /// Unit geometric normal, pointing to the front.
+    pub normal: Vec3,
+    /// Area.
+    pub area: f32,
+    /// The planar surface it belongs to.
+    pub surface: u32,
+}
+
+/// A planar surface: connected triangles, coplanar within a tolerance, of one material and
+/// facing one way. Later stages keep samples, areas and interpolation within one surface side.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Unit normal of the plane (area-weighted over its triangles), pointing to the front.
+    pub normal: Vec3,
+    /// Plane offset: points x of the surface satisfy `normal · x ≈ offset`.
+    pub offset: f32,
+    /// Its triangles: a range of [`Scene::triangles`].
+    pub triangles: Range<u32>,
+    /// Total area.
+    pub area: f64,
+    /// Whether its back side reflects light too (`two_sided` scenes, non-emitting surfaces).
+    pub two_sided: bool,
+}
+
+/// An isotropic point light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    /// Position.
+    pub position: Vec3,
+    /// Radiant intensity, W/sr, RGB.
+    pub intensity: Vec3,
+}
+
+impl PointLight {
+    /// Emitted power, 4π·I.
+    pub fn power(&self) -> DVec3 {
+        4.0 * std::f64::consts::PI * self.intensity.as_dvec3()
+    }
+}
+
+/// Solver defaults a scene file may carry in `[solver]`; command-line options override them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolverDefaults {
+    /// Poisson-disk spacing of the initial samples, scene units.
+    pub epsilon: Option<f32>,
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Bounds {
+    /// The box around some points (an empty set gives an inverted box).
+    pub fn around(points: impl IntoIterator<Item = Vec3>) -> Self {
+        points.into_iter().fold(
+            Bounds {
+                min: Vec3::splat(f32::INFINITY),
+                max: Vec3::splat(f32::NEG_INFINITY),
+            },
+            |b, p| Bounds {
+                min: b.min.min(p),
+                max: b.max.max(p),
+            },
+        )
+    }
+
+    /// Length of the diagonal: the scene's size scale.
+    pub fn diagonal(&self) -> f32 {
+        (self.max - self.min).length()
+    }
+}
+
+/// Triangle geometry with a material per triangle: what an OBJ file holds, or what a host
+/// program hands over.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Triangles as indices into `positions`, counter-clockwise seen from the front.
+    pub triangles: Vec<[u32; 3]>,
+    /// Material of each triangle: an index into `materials`.
+    pub triangle_materials: Vec<u32>,
+    /// The materials.
+    pub materials: Vec<Material>,
+}
+
+/// Everything a scene is made of, before validation and surface grouping.
+#[derive(Clone, Debug)]
+pub struct SceneParts {
+    /// The geometry and materials.
+    pub mesh: Mesh,
+    /// Point lights.
+    pub point_lights: Vec<PointLight>,
+    /// The camera.
+    pub camera: Camera,
+    /// Whether non-emitting faces reflect on both sides.
+    pub two_sided: bool,
+    /// Solver defaults.
+    pub solver: SolverDefaults,
+}
+
+/// A loaded, validated scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Where it came from: the scene file, or the name a host program gave.
+    pub path: PathBuf,
+    /// Materials, indexed by [`Surface::material`].
+    pub materials: Vec<Material>,
+    /// Triangles, ordered so that each surface's triangles are contiguous.
+    pub triangles: Vec<Triangle>,
+    /// Planar surfaces.
+    pub surfaces: Vec<Surface>,
+    /// Point lights.
+    pub point_lights: Vec<PointLight>,
+    /// The camera.
+    pub camera: Camera,
+    /// Whether non-emitting faces reflect on both sides.
+    pub two_sided: bool,
+    /// Solver defaults from the scene file.
+    pub solver: SolverDefaults,
+    /// Bounds of all triangles.
+    pub bounds: Bounds,
+    /// Things worth telling the user that did not stop loading (each said once).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// Loads a scene file (TOML) and the OBJ/MTL it points at.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
+        let path = path.as_ref();
+        let file = file::read(path)?;
+        let (mesh, mut warnings) = obj::read(&file.obj)?;
+        let parts = SceneParts {
+            mesh,
+            point_lights: file.point_lights,
+            camera: file.camera,
+            two_sided: file.two_sided,
+            solver: file.solver,
+        };
+        let mut scene = Scene::build(path, parts, &file.obj)?;
+        warnings.append(&mut scene.warnings);
+        scene.warnings = warnings;
+        Ok(scene)
+    }
+
+    /// Builds a scene from parts a host program made; errors name `name`.
+    pub fn from_parts(name: impl Into<PathBuf>, parts: SceneParts) -> Result<Scene> {
+        let name = name.into();
+        validate::parts(&name, &parts)?;
+        Scene::build(&name, parts.clone(), &name)
+    }
+
+    /// Drops degenerate triangles, groups surfaces; `geometry_path` is named in geometry errors.
+    fn build(path: &Path, parts: SceneParts, geometry_path: &Path) -> Result<Scene> {
+        let SceneParts {
+            mesh,
+            point_lights,
+            camera,
+            two_sided,
+            solver,
+        } = parts;
+        let mut warnings = Vec::new();
+        let (kept, dropped) = surfaces::drop_degenerate(&mesh);
+        if dropped > 0 {
+            warnings.push(format!(
+                "{}: dropped {dropped} zero-area triangle{}",
+                geometry_path.display(),
+                if dropped == 1 { "" } else { "s" }
+            ));
+        }
+        if kept.is_empty() {
+            return Err(Error::scene(
+                geometry_path,
+                None,
+                "the scene has no geometry (no triangle with a non-zero area)",
+            ));
+        }
+        let bounds = Bounds::around(kept.iter().flat_map(|t| t.vertices));
+        let (triangles, surfaces) =
+            surfaces::group(&kept, &mesh.materials, two_sided, bounds.diagonal());
+        Ok(Scene {
+            path: path.to_path_buf(),
+            materials: mesh.materials,
+            triangles,
+            surfaces,
+            point_lights,
+            camera,
+            two_sided,
+            solver,
+            bounds,
+            warnings,
+        })
+    }
+
+    /// The material of a surface.
+    pub fn material_of(&self, surface: u32) -> &Material {
+        &self.materials[self.surfaces[surface as usize].material as usize]
+    }
+
+    /// Total area of all triangles.
+    pub fn total_area(&self) -> f64 {
+        self.surfaces.iter().map(|s| s.area).sum()
+    }
+
+    /// Emitting surfaces with the power each emits, π·Ke·area (W, RGB).
+    pub fn emitters(&self) -> impl Iterator<Item = (u32, DVec3)> + '_ {
+        self.surfaces.iter().enumerate().filter_map(|(i, s)| {
+            let m = &self.materials[s.material as usize];
+            m.is_emitter()
+                .then(|| (i as u32, std::f64::consts::PI * m.ke.as_dvec3() * s.area))
+        })
+    }
+
+    /// Power emitted by all area lights and point lights (W, RGB).
+    pub fn emitted_power(&self) -> DVec3 {
+        let area: DVec3 = self.emitters().map(|(_, p)| p).sum();
+        let points: DVec3 = self.point_lights.iter().map(PointLight::power).sum();
+        area + points
+    }
+}

@@ -1,0 +1,151 @@
+//! Checks shared by the file loader (which adds file and line) and by `Scene::from_parts`:
+//! finite numbers, reflectance in [0, 1), non-negative emission and intensities, sane sizes.
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::{Material, PointLight, SceneParts};
+use crate::error::{Error, Result};
+
+/// Largest coordinate magnitude accepted: squared distances must stay finite in f32.
+pub(crate) const MAX_COORDINATE: f32 = 1e15;
+
+fn rgb(v: Vec3) -> String {
+    format!("{} {} {}", v.x, v.y, v.z)
+}
+
+/// Which material field a problem is in (the loader points at that field's line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum MaterialField {
+    Kd,
+    Ke,
+}
+
+/// Why a material is invalid, if it is, and in which field.
+pub(crate) fn material_field(m: &Material) -> Option<(MaterialField, String)> {
+    if !m.kd.is_finite() {
+        let problem = format!(
+            "material '{}': Kd {} is not a finite number",
+            m.name,
+            rgb(m.kd)
+        );
+        return Some((MaterialField::Kd, problem));
+    }
+    if m.kd.min_element() < 0.0 || m.kd.max_element() >= 1.0 {
+        let problem = format!(
+            "material '{}': Kd {} is outside [0, 1): a reflectance of 1 or more creates energy",
+            m.name,
+            rgb(m.kd)
+        );
+        return Some((MaterialField::Kd, problem));
+    }
+    if !m.ke.is_finite() {
+        let problem = format!(
+            "material '{}': Ke {} is not a finite number",
+            m.name,
+            rgb(m.ke)
+        );
+        return Some((MaterialField::Ke, problem));
+    }
+    if m.ke.min_element() < 0.0 {
+        let problem = format!("material '{}': Ke {} is negative", m.name, rgb(m.ke));
+        return Some((MaterialField::Ke, problem));
+    }
+    None
+}
+
+/// Why a point light is invalid, if it is.
+pub(crate) fn point_light(l: &PointLight) -> Option<String> {
+    if let Some(problem) = position(l.position) {
+        return Some(format!("point light position: {problem}"));
+    }
+    if !l.intensity.is_finite() {
+        return Some(format!(
+            "point light intensity {} is not a finite number",
+            rgb(l.intensity)
+        ));
+    }
+    if l.intensity.min_element() < 0.0 {
+        return Some(format!(
+            "point light intensity {} is negative",
+            rgb(l.intensity)
+        ));
+    }
+    None
+}
+
+/// Why a position is unusable, if it is.
+pub(crate) fn position(p: Vec3) -> Option<String> {
+    if !p.is_finite() {
+        return Some(format!("coordinate {} is NaN or infinite", rgb(p)));
+    }
+    if p.abs().max_element() > MAX_COORDINATE {
+        return Some(format!(
+            "coordinate {} is too large (magnitude at most {MAX_COORDINATE:e})",
+            rgb(p)
+        ));
+    }
+    None
+}
+
+/// Why a Poisson-disk spacing is unusable, if it is.
+pub(crate) fn epsilon(epsilon: f32) -> Option<String> {
+    (!(epsilon.is_finite() && epsilon > 0.0))
+        .then(|| format!("epsilon = {epsilon}: it must be a positive finite length"))
+}
+
+/// Checks scene parts a host program built; errors name `name`.
+pub(crate) fn parts(name: &Path, parts: &SceneParts) -> Result<()> {
+    let fail = |problem: String| Err(Error::scene(name, None, problem));
+    let mesh = &parts.mesh;
+    if let Some(problem) = mesh
+        .materials
+        .iter()
+        .find_map(material_field)
+        .map(|(_, p)| p)
+    {
+        return fail(problem);
+    }
+    for (i, p) in mesh.positions.iter().enumerate() {
+        if let Some(problem) = position(*p) {
+            return fail(format!("vertex {i}: {problem}"));
+        }
+    }
+    if mesh.triangle_materials.len() != mesh.triangles.len() {
+        return fail(format!(
+            "{} triangles but {} triangle materials",
+            mesh.triangles.len(),
+            mesh.triangle_materials.len()
+        ));
+    }
+    for (i, (t, &m)) in mesh
+        .triangles
+        .iter()
+        .zip(&mesh.triangle_materials)
+        .enumerate()
+    {
+        if let Some(&v) = t.iter().find(|&&v| v as usize >= mesh.positions.len()) {
+            return fail(format!(
+                "triangle {i}: vertex index {v} is out of range ({} vertices)",
+                mesh.positions.len()
+            ));
+        }
+        if m as usize >= mesh.materials.len() {
+            return fail(format!(
+                "triangle {i}: material index {m} is out of range ({} materials)",
+                mesh.materials.len()
+            ));
+        }
+    }
+    if let Some(problem) = parts.point_lights.iter().find_map(point_light) {
+        return fail(problem);
+    }
+    if let Some(problem) = parts.camera.problem() {
+        return fail(problem);
+    }
+    if let Some(problem) = parts.solver.epsilon.and_then(epsilon) {
+        return fail(format!("solver {problem}"));
+    }
+    Ok(())
+}

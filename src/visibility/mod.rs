@@ -1,0 +1,155 @@
+//! Visibility: the one trait the solver and renderer ask, answered a batch at a time by Embree
+//! (through our C shim in `ffi/`) or by the pure-Rust `obvhs` BVH.
+
+pub mod bench;
+mod bvh;
+#[cfg(feature = "embree")]
+mod embree;
+pub mod workload;
+
+use std::fmt;
+use std::str::FromStr;
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+
+pub use bvh::{BvhPreset, BvhScene};
+#[cfg(feature = "embree")]
+pub use embree::{headers as embree_headers, EmbreeMode, EmbreeOptions, EmbreeScene};
+
+/// A segment between two points. The backends test it over the parameter interval
+/// [`SEGMENT_T_MIN`, `SEGMENT_T_MAX`] of `a + t (b − a)`: the ends themselves never block.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Segment {
+    /// Start.
+    pub a: Vec3,
+    /// End.
+    pub b: Vec3,
+}
+
+/// Hits closer to a segment's start than this fraction of its length are ignored.
+pub const SEGMENT_T_MIN: f32 = 1e-4;
+/// Hits closer to a segment's end than `1 − SEGMENT_T_MAX` of its length are ignored.
+pub const SEGMENT_T_MAX: f32 = 1.0 - 1e-4;
+
+/// A ray with the distance interval in which hits count.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Ray {
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction; distances `t` are in units of its length.
+    pub dir: Vec3,
+    /// Nearest distance a hit may have.
+    pub t_min: f32,
+    /// Farthest distance a hit may have.
+    pub t_max: f32,
+}
+
+/// The nearest hit of a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray, in units of its direction's length.
+    pub t: f32,
+    /// Index into [`Scene::triangles`].
+    pub triangle: u32,
+}
+
+/// Answers visibility questions about one scene, a batch at a time, from any number of threads.
+pub trait Visibility: Send + Sync {
+    /// The backend's name, as `--backend` spells it.
+    fn name(&self) -> &'static str;
+
+    /// For each segment, whether anything blocks it (see [`Segment`]); `out.len()` must equal
+    /// `segments.len()`.
+    fn occluded(&self, segments: &[Segment], out: &mut [bool]) -> Result<()>;
+
+    /// For each ray, its nearest hit or `None`; `out.len()` must equal `rays.len()`.
+    fn intersect(&self, rays: &[Ray], out: &mut [Option<Hit>]) -> Result<()>;
+}
+
+/// The visibility backends meshlight has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Backend {
+    /// Embree through `ffi/` (feature `embree`).
+    Embree,
+    /// The pure-Rust `obvhs` BVH.
+    Bvh,
+}
+
+impl Backend {
+    /// Every backend compiled into this build, the default first.
+    pub fn available() -> Vec<Backend> {
+        let mut all = Vec::new();
+        if cfg!(feature = "embree") {
+            all.push(Backend::Embree);
+        }
+        all.push(Backend::Bvh);
+        all
+    }
+
+    /// Embree where compiled in, else obvhs.
+    pub fn default_backend() -> Backend {
+        Backend::available()[0]
+    }
+
+    /// The name `--backend` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Embree => "embree",
+            Backend::Bvh => "bvh",
+        }
+    }
+
+    /// Builds this backend over a scene's triangles with its default settings.
+    pub fn build(self, scene: &Scene) -> Result<Box<dyn Visibility>> {
+        match self {
+            #[cfg(feature = "embree")]
+            Backend::Embree => Ok(Box::new(EmbreeScene::new(scene, EmbreeOptions::default())?)),
+            #[cfg(not(feature = "embree"))]
+            Backend::Embree => Err(Error::Backend {
+                backend: "embree",
+                problem: "this build has no Embree backend (built without the `embree` feature)"
+                    .into(),
+            }),
+            Backend::Bvh => Ok(Box::new(BvhScene::new(scene, BvhPreset::default()))),
+        }
+    }
+}
+
+impl fmt::Display for Backend {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Backend {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Backend> {
+        match s {
+            "embree" => Ok(Backend::Embree),
+            "bvh" | "obvhs" => Ok(Backend::Bvh),
+            other => Err(Error::Option {
+                option: "backend",
+                problem: format!("unknown backend '{other}' (known: embree, bvh)"),
+            }),
+        }
+    }
+}
+
+/// Fails unless a batch's output has one slot per query.
+pub(crate) fn check_lengths(backend: &'static str, queries: usize, out: usize) -> Result<()> {
+    if queries == out {
+        Ok(())
+    } else {
+        Err(Error::Backend {
+            backend,
+            problem: format!("{queries} queries but {out} output slots"),
+        })
+    }
+}
