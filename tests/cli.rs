@@ -1,0 +1,79 @@
+//! The `meshlight` command, black-box: what it prints and how it fails.
+
+use std::process::{Command, Output};
+
+fn meshlight(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_meshlight"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run meshlight")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+#[test]
+fn info_summarises_the_room() {
+    let out = meshlight(&["info", "scenes/room/scene.toml"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    for expected in [
+        "triangles     34",
+        "surfaces      17",
+        "total area    221.05",
+        "area lights   1 surface(s), area 1.440000, power 45.2389 45.2389 45.2389 W",
+        "point lights  0",
+        "fov_y 60°, 512x512",
+        "(diagonal 9.526",
+    ] {
+        assert!(stdout.contains(expected), "missing '{expected}' in:\n{stdout}");
+    }
+}
+
+#[test]
+fn errors_name_the_file_and_exit_non_zero() {
+    let out = meshlight(&["info", "scenes/nowhere/scene.toml"]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("scenes/nowhere/scene.toml: cannot read"), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+}
+
+#[test]
+fn unknown_backend_is_refused() {
+    let out = meshlight(&["bench-vis", "scenes/box/scene.toml", "--backend", "optix"]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("unknown backend 'optix'"), "{}", text(&out.stderr));
+}
+
+#[test]
+fn bench_vis_prints_rates_for_every_backend_and_their_agreement() {
+    let out = meshlight(&[
+        "bench-vis", "scenes/room/scene.toml", "--queries", "20000", "--rays", "2000", "--repeats", "1",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("20000 occlusion segments"), "{stdout}");
+    assert!(stdout.contains("bvh thorough-wide"), "{stdout}");
+    if cfg!(feature = "embree") {
+        assert!(stdout.contains("embree 3") || stdout.contains("embree 4"), "{stdout}");
+        assert!(stdout.contains("trait / best raw path, 2 thread(s)"), "{stdout}");
+        assert!(stdout.contains("agreement embree vs bvh: 0 of 20000"), "{stdout}");
+    }
+}
+
+#[test]
+fn gallery_generator_writes_a_loadable_reduced_gallery() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    meshlight_gallery::write_obj(dir.path(), meshlight_gallery::GalleryOptions { tile: 0.5, sphere_detail: 0 })
+        .unwrap();
+    for file in ["scene.toml", "gallery.mtl"] {
+        std::fs::copy(meshlight_gallery::shipped_dir().join(file), dir.path().join(file)).unwrap();
+    }
+    let out = meshlight(&["info", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("point lights  8"), "{}", text(&out.stdout));
+}
