@@ -26,7 +26,9 @@ fn visibility(c: &mut Criterion) {
         let segments = facing_segments(&scene, SEGMENTS, 1);
         let rays = camera_rays(&scene, RAYS, 2);
         let mut group = c.benchmark_group(format!("visibility/{name}"));
-        group.sample_size(10).measurement_time(Duration::from_secs(4));
+        group
+            .sample_size(10)
+            .measurement_time(Duration::from_secs(4));
         for backend in Backend::available() {
             let vis = backend.build(&scene).expect("build backend");
             let mut occluded = vec![false; segments.len()];

@@ -28,7 +28,10 @@ fn info_summarises_the_room() {
         "fov_y 60°, 512x512",
         "(diagonal 9.526",
     ] {
-        assert!(stdout.contains(expected), "missing '{expected}' in:\n{stdout}");
+        assert!(
+            stdout.contains(expected),
+            "missing '{expected}' in:\n{stdout}"
+        );
     }
 }
 
@@ -37,7 +40,10 @@ fn errors_name_the_file_and_exit_non_zero() {
     let out = meshlight(&["info", "scenes/nowhere/scene.toml"]);
     assert!(!out.status.success());
     let stderr = text(&out.stderr);
-    assert!(stderr.contains("scenes/nowhere/scene.toml: cannot read"), "{stderr}");
+    assert!(
+        stderr.contains("scenes/nowhere/scene.toml: cannot read"),
+        "{stderr}"
+    );
     assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
 }
 
@@ -45,22 +51,42 @@ fn errors_name_the_file_and_exit_non_zero() {
 fn unknown_backend_is_refused() {
     let out = meshlight(&["bench-vis", "scenes/box/scene.toml", "--backend", "optix"]);
     assert!(!out.status.success());
-    assert!(text(&out.stderr).contains("unknown backend 'optix'"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("unknown backend 'optix'"),
+        "{}",
+        text(&out.stderr)
+    );
 }
 
 #[test]
 fn bench_vis_prints_rates_for_every_backend_and_their_agreement() {
     let out = meshlight(&[
-        "bench-vis", "scenes/room/scene.toml", "--queries", "20000", "--rays", "2000", "--repeats", "1",
+        "bench-vis",
+        "scenes/room/scene.toml",
+        "--queries",
+        "20000",
+        "--rays",
+        "2000",
+        "--repeats",
+        "1",
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
     assert!(stdout.contains("20000 occlusion segments"), "{stdout}");
     assert!(stdout.contains("bvh thorough-wide"), "{stdout}");
     if cfg!(feature = "embree") {
-        assert!(stdout.contains("embree 3") || stdout.contains("embree 4"), "{stdout}");
-        assert!(stdout.contains("trait / best raw path, 2 thread(s)"), "{stdout}");
-        assert!(stdout.contains("agreement embree vs bvh: 0 of 20000"), "{stdout}");
+        assert!(
+            stdout.contains("embree 3") || stdout.contains("embree 4"),
+            "{stdout}"
+        );
+        assert!(
+            stdout.contains("trait / best raw path, 2 thread(s)"),
+            "{stdout}"
+        );
+        assert!(
+            stdout.contains("agreement embree vs bvh: 0 of 20000"),
+            "{stdout}"
+        );
     }
 }
 
@@ -68,12 +94,26 @@ fn bench_vis_prints_rates_for_every_backend_and_their_agreement() {
 fn gallery_generator_writes_a_loadable_reduced_gallery() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.toml");
-    meshlight_gallery::write_obj(dir.path(), meshlight_gallery::GalleryOptions { tile: 0.5, sphere_detail: 0 })
-        .unwrap();
+    meshlight_gallery::write_obj(
+        dir.path(),
+        meshlight_gallery::GalleryOptions {
+            tile: 0.5,
+            sphere_detail: 0,
+        },
+    )
+    .unwrap();
     for file in ["scene.toml", "gallery.mtl"] {
-        std::fs::copy(meshlight_gallery::shipped_dir().join(file), dir.path().join(file)).unwrap();
+        std::fs::copy(
+            meshlight_gallery::shipped_dir().join(file),
+            dir.path().join(file),
+        )
+        .unwrap();
     }
     let out = meshlight(&["info", path.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("point lights  8"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("point lights  8"),
+        "{}",
+        text(&out.stdout)
+    );
 }

@@ -37,7 +37,11 @@ struct Files<'a> {
 
 impl Default for Files<'_> {
     fn default() -> Self {
-        Files { toml: TOML, obj: OBJ, mtl: MTL }
+        Files {
+            toml: TOML,
+            obj: OBJ,
+            mtl: MTL,
+        }
     }
 }
 
@@ -54,7 +58,9 @@ fn error(files: Files) -> String {
     let path = write(dir.path(), &files);
     match Scene::load(&path) {
         Ok(_) => panic!("the scene loaded, but an error was expected"),
-        Err(e) => e.to_string().replace(&format!("{}/", dir.path().display()), ""),
+        Err(e) => e
+            .to_string()
+            .replace(&format!("{}/", dir.path().display()), ""),
     }
 }
 
@@ -63,7 +69,10 @@ fn assert_names(message: &str, location: &str, problem: &str) {
         message.starts_with(location),
         "message should start with '{location}': {message}"
     );
-    assert!(message.contains(problem), "message should say '{problem}': {message}");
+    assert!(
+        message.contains(problem),
+        "message should say '{problem}': {message}"
+    );
 }
 
 #[test]
@@ -79,7 +88,10 @@ fn missing_files_are_named() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("nothing.toml");
     let e = Scene::load(&missing).unwrap_err().to_string();
-    assert!(e.contains("nothing.toml") && e.contains("cannot read"), "{e}");
+    assert!(
+        e.contains("nothing.toml") && e.contains("cannot read"),
+        "{e}"
+    );
 
     let path = write(dir.path(), &Files::default());
     std::fs::remove_file(dir.path().join("s.obj")).unwrap();
@@ -94,63 +106,179 @@ fn missing_files_are_named() {
 
 #[test]
 fn toml_that_does_not_parse() {
-    let e = error(Files { toml: "obj = \"s.obj\"\n[camera\n", ..Files::default() });
+    let e = error(Files {
+        toml: "obj = \"s.obj\"\n[camera\n",
+        ..Files::default()
+    });
     assert_names(&e, "scene.toml:2:", "");
-    let e = error(Files { toml: "obj = \"s.obj\"\n", ..Files::default() });
+    let e = error(Files {
+        toml: "obj = \"s.obj\"\n",
+        ..Files::default()
+    });
     assert_names(&e, "scene.toml", "missing field `camera`");
 }
 
 #[test]
 fn unknown_toml_keys_are_errors() {
     let toml = TOML.replace("fov_y = 40.0", "fov_y = 40.0\nfocal = 3");
-    assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:", "unknown field `focal`");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:",
+        "unknown field `focal`",
+    );
     let toml = format!("{TOML}\n[solver]\nepsilon = 0.1\nzeta_typo = 1\n");
-    assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:", "unknown field `zeta_typo`");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:",
+        "unknown field `zeta_typo`",
+    );
 }
 
 #[test]
 fn obj_that_does_not_parse() {
     let obj = OBJ.replace("v 1 1 0", "v 1 one 0");
-    assert_names(&error(Files { obj: &obj, ..Files::default() }), "s.obj:4:", "vertex needs three numbers");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:4:",
+        "vertex needs three numbers",
+    );
     let obj = OBJ.replace("f 1 2 3 4", "f 1 2 x 4");
-    assert_names(&error(Files { obj: &obj, ..Files::default() }), "s.obj:7:", "face vertex 'x'");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:7:",
+        "face vertex 'x'",
+    );
     let obj = OBJ.replace("f 1 2 3 4", "f 1 2 3 9");
-    assert_names(&error(Files { obj: &obj, ..Files::default() }), "s.obj:7:", "vertex index 9 is out of range");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:7:",
+        "vertex index 9 is out of range",
+    );
     let obj = OBJ.replace("usemtl white", "usemtl chalk");
-    assert_names(&error(Files { obj: &obj, ..Files::default() }), "s.obj:6:", "usemtl 'chalk'");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:6:",
+        "usemtl 'chalk'",
+    );
 }
 
 #[test]
 fn mtl_that_does_not_parse() {
     let mtl = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5");
-    assert_names(&error(Files { mtl: &mtl, ..Files::default() }), "s.mtl:2:", "Kd needs three numbers");
+    assert_names(
+        &error(Files {
+            mtl: &mtl,
+            ..Files::default()
+        }),
+        "s.mtl:2:",
+        "Kd needs three numbers",
+    );
     let mtl = "Kd 0.5 0.5 0.5\nnewmtl white\n";
-    assert_names(&error(Files { mtl, ..Files::default() }), "s.mtl:1:", "Kd before any newmtl");
+    assert_names(
+        &error(Files {
+            mtl,
+            ..Files::default()
+        }),
+        "s.mtl:1:",
+        "Kd before any newmtl",
+    );
     let mtl = format!("{MTL}newmtl white\nKd 0.1 0.1 0.1\n");
-    assert_names(&error(Files { mtl: &mtl, ..Files::default() }), "s.mtl:3:", "defined twice");
+    assert_names(
+        &error(Files {
+            mtl: &mtl,
+            ..Files::default()
+        }),
+        "s.mtl:3:",
+        "defined twice",
+    );
 }
 
 #[test]
 fn nan_and_infinite_numbers() {
     let obj = OBJ.replace("v 1 1 0", "v 1 NaN 0");
-    assert_names(&error(Files { obj: &obj, ..Files::default() }), "s.obj:4:", "NaN or infinite");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:4:",
+        "NaN or infinite",
+    );
     let obj = OBJ.replace("v 1 1 0", "v 1 inf 0");
-    assert_names(&error(Files { obj: &obj, ..Files::default() }), "s.obj:4:", "NaN or infinite");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:4:",
+        "NaN or infinite",
+    );
     let mtl = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 nan 0.5");
-    assert_names(&error(Files { mtl: &mtl, ..Files::default() }), "s.mtl:2:", "not a finite number");
+    assert_names(
+        &error(Files {
+            mtl: &mtl,
+            ..Files::default()
+        }),
+        "s.mtl:2:",
+        "not a finite number",
+    );
     let toml = TOML.replace("position = [0.5, 0.5, 3.0]", "position = [0.5, nan, 3.0]");
-    assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:3:", "finite");
-    let toml = format!("{TOML}\n[[point_light]]\nposition = [0.5, 0.5, 1.0]\nintensity = [1.0, inf, 1.0]\n");
-    assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:10:", "not a finite number");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:3:",
+        "finite",
+    );
+    let toml = format!(
+        "{TOML}\n[[point_light]]\nposition = [0.5, 0.5, 1.0]\nintensity = [1.0, inf, 1.0]\n"
+    );
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:10:",
+        "not a finite number",
+    );
     let toml = format!("{TOML}\n[solver]\nepsilon = nan\n");
-    assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:10:", "epsilon");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:10:",
+        "epsilon",
+    );
 }
 
 #[test]
 fn reflectance_outside_zero_to_one() {
     for kd in ["Kd 1 0.5 0.5", "Kd 0.5 1.2 0.5", "Kd -0.1 0.5 0.5"] {
         let mtl = MTL.replace("Kd 0.5 0.5 0.5", kd);
-        let e = error(Files { mtl: &mtl, ..Files::default() });
+        let e = error(Files {
+            mtl: &mtl,
+            ..Files::default()
+        });
         assert_names(&e, "s.mtl:2:", "material 'white'");
         assert!(e.contains("outside [0, 1)"), "{e}");
     }
@@ -159,9 +287,25 @@ fn reflectance_outside_zero_to_one() {
 #[test]
 fn negative_emission_and_intensity() {
     let mtl = format!("{MTL}Ke 1 -1 1\n");
-    assert_names(&error(Files { mtl: &mtl, ..Files::default() }), "s.mtl:3:", "Ke 1 -1 1 is negative");
-    let toml = format!("{TOML}\n[[point_light]]\nposition = [0.5, 0.5, 1.0]\nintensity = [1.0, -2.0, 1.0]\n");
-    assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:10:", "intensity 1 -2 1 is negative");
+    assert_names(
+        &error(Files {
+            mtl: &mtl,
+            ..Files::default()
+        }),
+        "s.mtl:3:",
+        "Ke 1 -1 1 is negative",
+    );
+    let toml = format!(
+        "{TOML}\n[[point_light]]\nposition = [0.5, 0.5, 1.0]\nintensity = [1.0, -2.0, 1.0]\n"
+    );
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:10:",
+        "intensity 1 -2 1 is negative",
+    );
 }
 
 #[test]
@@ -170,44 +314,106 @@ fn zero_size_and_degenerate_cameras() {
         ("width = 32", "width = 0", "empty"),
         ("fov_y = 40.0", "fov_y = 0.0", "fov_y"),
         ("fov_y = 40.0", "fov_y = 180.0", "fov_y"),
-        ("look_at = [0.5, 0.5, 0.0]", "look_at = [0.5, 0.5, 3.0]", "look_at equals its position"),
-        ("fov_y = 40.0", "up = [0.0, 0.0, 1.0]\nfov_y = 40.0", "parallel"),
+        (
+            "look_at = [0.5, 0.5, 0.0]",
+            "look_at = [0.5, 0.5, 3.0]",
+            "look_at equals its position",
+        ),
+        (
+            "fov_y = 40.0",
+            "up = [0.0, 0.0, 1.0]\nfov_y = 40.0",
+            "parallel",
+        ),
     ];
     for (from, to, problem) in cases {
         let toml = TOML.replace(from, to);
-        assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:3:", problem);
+        assert_names(
+            &error(Files {
+                toml: &toml,
+                ..Files::default()
+            }),
+            "scene.toml:3:",
+            problem,
+        );
     }
     let toml = TOML.replace("width = 32", "width = -4");
-    assert_names(&error(Files { toml: &toml, ..Files::default() }), "scene.toml:7:", "invalid value");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:7:",
+        "invalid value",
+    );
 }
 
 #[test]
 fn a_scene_with_no_geometry() {
     let obj = "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 2 0 0\n";
-    assert_names(&error(Files { obj, ..Files::default() }), "s.obj", "no geometry");
+    assert_names(
+        &error(Files {
+            obj,
+            ..Files::default()
+        }),
+        "s.obj",
+        "no geometry",
+    );
     // Only zero-area triangles: nothing is left either.
     let obj = "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 2 0 0\nusemtl white\nf 1 2 3\n";
-    assert_names(&error(Files { obj, ..Files::default() }), "s.obj", "no geometry");
+    assert_names(
+        &error(Files {
+            obj,
+            ..Files::default()
+        }),
+        "s.obj",
+        "no geometry",
+    );
 }
 
 #[test]
 fn zero_area_triangles_are_dropped_with_one_warning() {
     let obj = format!("{OBJ}v 5 5 5\nf 1 1 2\nf 5 5 5\nf 1 2 2\n");
     let dir = tempfile::tempdir().unwrap();
-    let scene = Scene::load(write(dir.path(), &Files { obj: &obj, ..Files::default() })).unwrap();
+    let scene = Scene::load(write(
+        dir.path(),
+        &Files {
+            obj: &obj,
+            ..Files::default()
+        },
+    ))
+    .unwrap();
     assert_eq!(scene.triangles.len(), 2);
-    let warnings: Vec<&String> = scene.warnings.iter().filter(|w| w.contains("zero-area")).collect();
+    let warnings: Vec<&String> = scene
+        .warnings
+        .iter()
+        .filter(|w| w.contains("zero-area"))
+        .collect();
     assert_eq!(warnings.len(), 1, "{:?}", scene.warnings);
-    assert!(warnings[0].contains("s.obj: dropped 3 zero-area triangles"), "{}", warnings[0]);
+    assert!(
+        warnings[0].contains("s.obj: dropped 3 zero-area triangles"),
+        "{}",
+        warnings[0]
+    );
 }
 
 #[test]
 fn faces_without_material_get_grey_and_one_warning() {
     let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
     let dir = tempfile::tempdir().unwrap();
-    let scene = Scene::load(write(dir.path(), &Files { obj, ..Files::default() })).unwrap();
+    let scene = Scene::load(write(
+        dir.path(),
+        &Files {
+            obj,
+            ..Files::default()
+        },
+    ))
+    .unwrap();
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
-    assert!(scene.warnings[0].contains("2 triangles have no material"), "{}", scene.warnings[0]);
+    assert!(
+        scene.warnings[0].contains("2 triangles have no material"),
+        "{}",
+        scene.warnings[0]
+    );
     assert_eq!(scene.material_of(0).kd, glam::Vec3::splat(0.5));
 }
 
@@ -222,21 +428,34 @@ fn binary_garbage_is_not_text() {
 
 #[test]
 fn host_built_scenes_are_checked_too() {
-    use meshlight::scene::{Camera, Material, Mesh, SceneParts, SolverDefaults};
     use glam::Vec3;
+    use meshlight::scene::{Camera, Material, Mesh, SceneParts, SolverDefaults};
     let parts = |kd: f32| SceneParts {
         mesh: Mesh {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
             triangles: vec![[0, 1, 2]],
             triangle_materials: vec![0],
-            materials: vec![Material { name: "m".into(), kd: Vec3::splat(kd), ke: Vec3::ZERO }],
+            materials: vec![Material {
+                name: "m".into(),
+                kd: Vec3::splat(kd),
+                ke: Vec3::ZERO,
+            }],
         },
         point_lights: vec![],
-        camera: Camera { position: Vec3::Z, look_at: Vec3::ZERO, up: Vec3::Y, fov_y: 45.0, width: 8, height: 8 },
+        camera: Camera {
+            position: Vec3::Z,
+            look_at: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y: 45.0,
+            width: 8,
+            height: 8,
+        },
         two_sided: false,
         solver: SolverDefaults::default(),
     };
     assert!(Scene::from_parts("host", parts(0.5)).is_ok());
-    let e = Scene::from_parts("host", parts(1.0)).unwrap_err().to_string();
+    let e = Scene::from_parts("host", parts(1.0))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("host: material 'm': Kd"), "{e}");
 }
