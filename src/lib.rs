@@ -14,10 +14,19 @@
 //! # Ok::<(), meshlight::Error>(())
 //! ```
 
+pub mod area;
 pub mod error;
+pub mod light;
+mod parallel;
+pub mod ply;
+pub mod render;
+pub mod sampling;
 pub mod scene;
+pub mod solver;
 pub mod visibility;
 
 pub use error::{Error, Result};
+pub use render::{render, Image, RenderOptions};
 pub use scene::Scene;
+pub use solver::{solve, Options, Solution};
 pub use visibility::{Backend, Visibility};

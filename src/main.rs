@@ -17,8 +17,70 @@ struct Args {
     command: Command,
 }
 
+/// Solver settings shared by `render` and `samples`.
+#[derive(clap::Args)]
+struct SolveArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Start from a preset: preview, default or final.
+    #[arg(long, default_value = "default")]
+    preset: String,
+    /// Poisson-disk spacing ε of the initial samples (default: the scene file's, else automatic).
+    #[arg(long)]
+    epsilon: Option<f32>,
+    /// Adaptive error threshold ζ, relative to the mean radiosity.
+    #[arg(long)]
+    zeta: Option<f32>,
+    /// Area weight fall-off α (eq. 5).
+    #[arg(long)]
+    alpha: Option<f32>,
+    /// Adaptive rounds after the first solve.
+    #[arg(long)]
+    rounds: Option<u32>,
+    /// Shadow rays per area light and sample.
+    #[arg(long)]
+    light_samples: Option<u32>,
+    /// Stop shooting when unshot power < this fraction of emitted power.
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// At most this many shots per solve.
+    #[arg(long)]
+    max_shots: Option<u64>,
+    /// Refuse to place more samples than this.
+    #[arg(long)]
+    max_samples: Option<usize>,
+    /// Visibility backend: embree or bvh.
+    #[arg(long)]
+    backend: Option<Backend>,
+    /// Worker threads.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Seed of all random choices.
+    #[arg(long)]
+    seed: Option<u64>,
+}
+
 #[derive(Subcommand)]
 enum Command {
+    /// Solve a scene and render its camera view: linear OpenEXR plus a tone-mapped PNG beside it.
+    Render {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// Output image (.exr); the PNG gets the same name with .png.
+        #[arg(short, long, default_value = "out.exr")]
+        output: PathBuf,
+        /// Rays per side on pixels that straddle an edge (1 = one ray per pixel).
+        #[arg(long, default_value_t = 4)]
+        supersample: u32,
+    },
+    /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
+    Samples {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// Output point cloud (.ply).
+        #[arg(short, long, default_value = "samples.ply")]
+        output: PathBuf,
+    },
     /// Print a summary of a scene: geometry, surfaces, lights, camera.
     Info {
         /// The scene file (TOML).
@@ -68,6 +130,55 @@ fn main() -> ExitCode {
 
 fn run(args: Args) -> anyhow::Result<()> {
     match args.command {
+        Command::Render {
+            solve,
+            output,
+            supersample,
+        } => {
+            let started = std::time::Instant::now();
+            let (scene, options) = cli::solve_setup(&solve)?;
+            let vis = options.backend.build(&scene)?;
+            let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
+            let render_options = meshlight::RenderOptions {
+                threads: options.threads,
+                supersample,
+            };
+            let t = std::time::Instant::now();
+            let (image, stats) =
+                meshlight::render(&scene, &solution, vis.as_ref(), &render_options)?;
+            let render_seconds = t.elapsed().as_secs_f64();
+            image.write_exr(&output)?;
+            let png = output.with_extension("png");
+            image.write_png(&png, image.auto_exposure())?;
+            print!("{}", cli::solve_summary(&scene, &solution, &options));
+            print!("{}", cli::render_summary(&image, &stats, render_seconds));
+            println!(
+                "total {:.2} s; wrote {} and {}",
+                started.elapsed().as_secs_f64(),
+                output.display(),
+                png.display()
+            );
+        }
+        Command::Samples { solve, output } => {
+            let (scene, options) = cli::solve_setup(&solve)?;
+            let vis = options.backend.build(&scene)?;
+            let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
+            let mean = solution
+                .radiosity
+                .iter()
+                .map(|b| b.element_sum() / 3.0)
+                .sum::<f64>()
+                / solution.radiosity.len().max(1) as f64
+                / std::f64::consts::PI;
+            let exposure = if mean > 0.0 { (0.4 / mean) as f32 } else { 1.0 };
+            meshlight::ply::write_samples(&solution, &output, exposure)?;
+            print!("{}", cli::solve_summary(&scene, &solution, &options));
+            println!(
+                "wrote {} ({} samples)",
+                output.display(),
+                solution.samples.len()
+            );
+        }
         Command::Info { scene } => {
             let scene = load(&scene)?;
             print!("{}", cli::info(&scene));

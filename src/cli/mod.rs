@@ -1,6 +1,12 @@
 //! What the CLI prints: text renderings of the library's reports.
 
 use std::fmt::Write;
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use meshlight::render::RenderStats;
+use meshlight::solver::{Control, EpsilonSource, Options, Phase, Progress, StopReason};
+use meshlight::{Image, Solution, Visibility};
 
 use glam::{DVec3, Vec3};
 use meshlight::visibility::bench::{BenchReport, Rate};
@@ -262,4 +268,163 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
         );
     }
     s
+}
+
+/// Options from a preset, the scene file and the command line, in that order of precedence.
+pub fn solve_setup(args: &crate::SolveArgs) -> anyhow::Result<(Scene, Options)> {
+    let scene = crate::load(&args.scene)?;
+    let mut o = match args.preset.as_str() {
+        "preview" => Options::preview(),
+        "default" => Options::default(),
+        "final" => Options::final_quality(),
+        other => anyhow::bail!("unknown --preset '{other}' (known: preview, default, final)"),
+    };
+    o.epsilon = args.epsilon.or(o.epsilon);
+    o.zeta = args.zeta.unwrap_or(o.zeta);
+    o.alpha = args.alpha.unwrap_or(o.alpha);
+    o.rounds = args.rounds.unwrap_or(o.rounds);
+    o.light_samples = args.light_samples.unwrap_or(o.light_samples);
+    o.tolerance = args.tolerance.unwrap_or(o.tolerance);
+    o.max_shots = args.max_shots.or(o.max_shots);
+    o.max_samples = args.max_samples.unwrap_or(o.max_samples);
+    o.backend = args.backend.unwrap_or(o.backend);
+    o.threads = args.threads.unwrap_or(o.threads).max(1);
+    o.seed = args.seed.unwrap_or(o.seed);
+    Ok((scene, o))
+}
+
+/// Solves with a progress line on stderr.
+pub fn solve_with_progress(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &Options,
+) -> anyhow::Result<Solution> {
+    let (epsilon, source) = meshlight::solver::choose_epsilon(scene, options)?;
+    if source == EpsilonSource::Automatic {
+        eprintln!(
+            "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area (about {} initial samples)",
+            meshlight::solver::AUTO_SAMPLES
+        );
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}").expect("valid template"),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    let solution = meshlight::solve(scene, vis, options, &mut |p: &Progress| {
+        bar.set_message(progress_line(p));
+        Control::Continue
+    });
+    bar.finish_and_clear();
+    Ok(solution?)
+}
+
+fn progress_line(p: &Progress) -> String {
+    let phase = match p.phase {
+        Phase::Sampling => "placing samples",
+        Phase::Areas => "representative areas",
+        Phase::DirectLight => "direct light",
+        Phase::Shooting => "shooting",
+        Phase::Adaptive => "adding samples",
+        _ => "working",
+    };
+    if p.phase == Phase::Shooting {
+        // Progress towards the tolerance on a log scale.
+        let done = (p.unshot_fraction.max(1e-300).ln() / p.tolerance.ln()).clamp(0.0, 1.0);
+        format!(
+            "round {}: {phase}: {} samples, {} shots, unshot {:.2e} of emitted (target {:.0e}), {:.0}%",
+            p.round,
+            p.samples,
+            p.shots,
+            p.unshot_fraction,
+            p.tolerance,
+            100.0 * done
+        )
+    } else {
+        format!("round {}: {phase}: {} samples", p.round, p.samples)
+    }
+}
+
+/// The solve's summary: samples per round, shots, queries, unshot fraction, time per phase.
+pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
+    let mut out = String::new();
+    let source = match s.epsilon_source {
+        EpsilonSource::Options => "command line",
+        EpsilonSource::SceneFile => "scene file",
+        EpsilonSource::Automatic => "automatic",
+        _ => "",
+    };
+    let _ = writeln!(
+        out,
+        "scene {}: {} triangles, {} surfaces; backend {}, {} thread(s); ε {} ({source}), α {}, ζ {}, {} light samples",
+        scene.path.display(),
+        scene.triangles.len(),
+        scene.surfaces.len(),
+        o.backend,
+        o.threads,
+        s.epsilon,
+        o.alpha,
+        o.zeta,
+        o.light_samples
+    );
+    let _ = writeln!(
+        out,
+        "{:>5} {:>8} {:>7} {:>7} {:>8} {:>11} {:>9} {:>17} {:>10} {:>8} {:>8} {:>8} {:>8}",
+        "round",
+        "samples",
+        "added",
+        "refined",
+        "shots",
+        "vis queries",
+        "shadow q",
+        "unshot start→end",
+        "stop",
+        "place s",
+        "areas s",
+        "direct s",
+        "shoot s"
+    );
+    for r in &s.rounds {
+        let stop = match r.shooting.stop {
+            StopReason::Converged => "converged",
+            StopReason::ShotLimit => "shot limit",
+            StopReason::Stopped => "stopped",
+            StopReason::NoLight => "no light",
+            _ => "?",
+        };
+        let _ = writeln!(
+            out,
+            "{:>5} {:>8} {:>7} {:>7} {:>8} {:>11} {:>9} {:>17} {:>10} {:>8.3} {:>8.3} {:>8.3} {:>8.3}{}",
+            r.round,
+            r.samples,
+            r.added,
+            r.refined,
+            r.shooting.shots,
+            r.shooting.queries,
+            r.direct_queries,
+            format!("{:.2e}→{:.2e}", r.shooting.initial_unshot_fraction, r.shooting.unshot_fraction),
+            stop,
+            r.seconds.sampling,
+            r.seconds.areas,
+            r.seconds.direct,
+            r.seconds.shooting,
+            if r.capped { "  (sample budget reached)" } else { "" }
+        );
+    }
+    if s.stop() == StopReason::ShotLimit {
+        let _ = writeln!(
+            out,
+            "warning: the last solve stopped at its shot limit with {:.2e} of the emitted power unshot",
+            s.rounds.last().map_or(0.0, |r| r.shooting.unshot_fraction)
+        );
+    }
+    out
+}
+
+/// The render's summary.
+pub fn render_summary(image: &Image, stats: &RenderStats, seconds: f64) -> String {
+    format!(
+        "render {}x{}: {} camera rays ({} edge pixels supersampled), {} interpolation queries, {:.3} s; mean radiance {:.5}\n",
+        image.width, image.height, stats.camera_rays, stats.supersampled_pixels, stats.interpolation_queries, seconds, image.mean()
+    )
 }

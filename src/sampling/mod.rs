@@ -1,0 +1,255 @@
+//! Sample points on the reflecting surface sides: storage (structure of arrays), a per-side
+//! spatial index for range queries, initial Poisson-disk placement (eq. 3) and adaptive
+//! addition (eqs. 7-8).
+
+pub mod adaptive;
+pub mod obstruction;
+pub mod poisson;
+pub mod surface_map;
+
+use glam::{Vec2, Vec3};
+
+use crate::scene::Scene;
+pub use obstruction::Obstruction;
+pub use surface_map::SurfaceMap;
+
+/// A surface side: `2 × surface + 1` for the back, `2 × surface` for the front. Samples, areas
+/// and interpolation never mix sides.
+pub type Side = u32;
+
+/// The side id of a surface's front or back.
+pub fn side_of(surface: u32, back: bool) -> Side {
+    2 * surface + u32::from(back)
+}
+
+/// The surface of a side.
+pub fn surface_of(side: Side) -> u32 {
+    side / 2
+}
+
+/// Whether a side is a back side.
+pub fn is_back(side: Side) -> bool {
+    side % 2 == 1
+}
+
+/// The sides that reflect light: fronts, and backs of two-sided surfaces, whose material has
+/// a non-zero reflectance. Only these get samples.
+pub fn reflecting_sides(scene: &Scene) -> Vec<Side> {
+    let mut sides = Vec::new();
+    for (i, s) in scene.surfaces.iter().enumerate() {
+        if scene.materials[s.material as usize].kd.max_element() > 0.0 {
+            sides.push(side_of(i as u32, false));
+            if s.two_sided {
+                sides.push(side_of(i as u32, true));
+            }
+        }
+    }
+    sides
+}
+
+/// The sample points, structure of arrays.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Samples {
+    /// Positions, on their surfaces.
+    pub position: Vec<Vec3>,
+    /// Unit normal of the side each sample is on.
+    pub normal: Vec<Vec3>,
+    /// 2D position in its surface's frame.
+    pub uv: Vec<Vec2>,
+    /// The side each sample is on.
+    pub side: Vec<Side>,
+    /// Influence radius D (eq. 3: ε initially; shrunk by adaptive rounds).
+    pub radius: Vec<f32>,
+    /// Representative area S (eqs. 4-6).
+    pub area: Vec<f64>,
+    /// The adaptive round in which each sample was added (0 = initial Poisson disk).
+    pub round: Vec<u16>,
+}
+
+impl Samples {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Appends one sample (area 0 until areas are computed).
+    pub fn push(&mut self, maps: &[SurfaceMap], side: Side, uv: Vec2, radius: f32, round: u16) {
+        let map = &maps[surface_of(side) as usize];
+        self.position.push(map.to_3d(uv));
+        self.normal.push(if is_back(side) {
+            -map.normal
+        } else {
+            map.normal
+        });
+        self.uv.push(uv);
+        self.side.push(side);
+        self.radius.push(radius);
+        self.area.push(0.0);
+        self.round.push(round);
+    }
+
+    /// Total area of the samples of each side (index: side id).
+    pub fn area_per_side(&self, sides: usize) -> Vec<f64> {
+        let mut total = vec![0.0; sides];
+        for (&s, &a) in self.side.iter().zip(&self.area) {
+            total[s as usize] += a;
+        }
+        total
+    }
+}
+
+/// Range queries over the samples of one side: a uniform 2D grid per side, in compressed rows.
+#[derive(Clone, Debug, Default)]
+pub struct SideIndex {
+    /// Per side: (first cell, nx, ny, min corner, cell size); `None` for sides without samples.
+    grids: Vec<Option<Grid>>,
+    /// Cell k's samples are entries[starts[k]..starts[k+1]].
+    starts: Vec<u32>,
+    entries: Vec<u32>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    first: usize,
+    nx: usize,
+    ny: usize,
+    min: Vec2,
+    cell: f32,
+}
+
+impl SideIndex {
+    /// Indexes the samples. A side's cells are `cell` wide (ε), narrower where adaptive rounds
+    /// shrank radii (down to twice the smallest radius), but never more than about four per
+    /// sample of the side, so big sparse sides stay small.
+    pub fn new(samples: &Samples, maps: &[SurfaceMap], cell: f32) -> SideIndex {
+        let sides = 2 * maps.len();
+        let mut count = vec![0usize; sides];
+        let mut smallest = vec![f32::INFINITY; sides];
+        for (&s, &d) in samples.side.iter().zip(&samples.radius) {
+            count[s as usize] += 1;
+            smallest[s as usize] = smallest[s as usize].min(d);
+        }
+        let mut grids = vec![None; sides];
+        let mut cells = 0usize;
+        for (side, &n) in count.iter().enumerate() {
+            if n == 0 {
+                continue;
+            }
+            let map = &maps[surface_of(side as u32) as usize];
+            let size = (map.max - map.min).max(Vec2::splat(1e-30));
+            let sparse = (map.area() as f32 / (4.0 * n as f32 + 16.0)).sqrt();
+            let c = (2.0 * smallest[side])
+                .min(cell)
+                .max(sparse)
+                .max(size.max_element() / 4096.0);
+            let nx = ((size.x / c).ceil() as usize).max(1);
+            let ny = ((size.y / c).ceil() as usize).max(1);
+            grids[side] = Some(Grid {
+                first: cells,
+                nx,
+                ny,
+                min: map.min,
+                cell: c,
+            });
+            cells += nx * ny;
+        }
+        let mut keys: Vec<(u32, u32)> = Vec::with_capacity(samples.len());
+        for (k, (&side, &uv)) in samples.side.iter().zip(&samples.uv).enumerate() {
+            let g = grids[side as usize].expect("a grid for every side with samples");
+            let (x, y) = g.cell_of(uv);
+            keys.push(((g.first + y * g.nx + x) as u32, k as u32));
+        }
+        keys.sort_unstable();
+        let mut starts = vec![0u32; cells + 1];
+        for &(c, _) in &keys {
+            starts[c as usize + 1] += 1;
+        }
+        for c in 0..cells {
+            starts[c + 1] += starts[c];
+        }
+        SideIndex {
+            grids,
+            starts,
+            entries: keys.into_iter().map(|(_, k)| k).collect(),
+        }
+    }
+
+    /// Calls `f(k)` for every sample k of `side` whose 2D position may lie within `r` of `uv`
+    /// (a superset: callers check the distance). In ascending sample order within each cell.
+    pub fn for_each_near(&self, side: Side, uv: Vec2, r: f32, mut f: impl FnMut(u32)) {
+        let Some(Some(g)) = self.grids.get(side as usize) else {
+            return;
+        };
+        let (x0, y0) = g.cell_of(uv - Vec2::splat(r));
+        let (x1, y1) = g.cell_of(uv + Vec2::splat(r));
+        for y in y0..=y1 {
+            let row = g.first + y * g.nx;
+            let (a, b) = (
+                self.starts[row + x0] as usize,
+                self.starts[row + x1 + 1] as usize,
+            );
+            for &k in &self.entries[a..b] {
+                f(k);
+            }
+        }
+    }
+
+    /// The samples of `side` within distance `r` of `uv`, with their squared distances.
+    pub fn within(
+        &self,
+        samples: &Samples,
+        side: Side,
+        uv: Vec2,
+        r: f32,
+        out: &mut Vec<(u32, f32)>,
+    ) {
+        out.clear();
+        let r2 = r * r;
+        self.for_each_near(side, uv, r, |k| {
+            let d2 = samples.uv[k as usize].distance_squared(uv);
+            if d2 <= r2 {
+                out.push((k, d2));
+            }
+        });
+    }
+
+    /// The nearest sample of `side` to `uv` (searching outwards), if the side has any.
+    pub fn nearest(&self, samples: &Samples, side: Side, uv: Vec2) -> Option<u32> {
+        let g = (*self.grids.get(side as usize)?)?;
+        let mut r = g.cell;
+        let reach = g.cell * (g.nx.max(g.ny) as f32 + 2.0);
+        loop {
+            let mut best: Option<(f32, u32)> = None;
+            self.for_each_near(side, uv, r, |k| {
+                let d2 = samples.uv[k as usize].distance_squared(uv);
+                if best.is_none_or(|(b, bk)| d2 < b || (d2 == b && k < bk)) {
+                    best = Some((d2, k));
+                }
+            });
+            // A hit within r is the nearest only if nothing outside the searched square is closer.
+            if let Some((d2, k)) = best {
+                if d2.sqrt() <= r || r > reach {
+                    return Some(k);
+                }
+            } else if r > reach {
+                return None;
+            }
+            r *= 2.0;
+        }
+    }
+}
+
+impl Grid {
+    fn cell_of(&self, p: Vec2) -> (usize, usize) {
+        let q = (p - self.min) / self.cell;
+        (
+            (q.x.max(0.0) as usize).min(self.nx - 1),
+            (q.y.max(0.0) as usize).min(self.ny - 1),
+        )
+    }
+}

@@ -1,0 +1,86 @@
+//! Helpers shared by the integration tests: scenes built from parts, and running a test body
+//! on every visibility backend.
+
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+use meshlight::scene::{Camera, Material, Mesh, PointLight, SceneParts, SolverDefaults};
+use meshlight::{Backend, Scene};
+
+/// A shipped scene's path.
+pub fn shipped(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name).join("scene.toml")
+}
+
+/// A diffuse material.
+pub fn material(name: &str, kd: f32, ke: f32) -> Material {
+    Material { name: name.into(), kd: Vec3::splat(kd), ke: Vec3::splat(ke) }
+}
+
+/// Builds a mesh from quads.
+#[derive(Default)]
+pub struct Builder {
+    pub mesh: Mesh,
+    pub point_lights: Vec<PointLight>,
+}
+
+impl Builder {
+    /// Adds a material and returns its index.
+    pub fn material(&mut self, m: Material) -> u32 {
+        self.mesh.materials.push(m);
+        self.mesh.materials.len() as u32 - 1
+    }
+
+    /// A quad a→b→c→d, counter-clockwise seen from its front.
+    pub fn quad(&mut self, corners: [Vec3; 4], material: u32) {
+        let base = self.mesh.positions.len() as u32;
+        self.mesh.positions.extend(corners);
+        self.mesh.triangles.push([base, base + 1, base + 2]);
+        self.mesh.triangles.push([base, base + 2, base + 3]);
+        self.mesh.triangle_materials.extend([material, material]);
+    }
+
+    /// An axis-aligned box seen from inside (faces pointing inwards), without the faces
+    /// listed in `skip` ("-x", "+x", "-y", "+y", "-z", "+z").
+    pub fn room(&mut self, lo: Vec3, hi: Vec3, material: u32, skip: &[&str]) {
+        let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+        let (a, b) = (lo, hi);
+        let faces = [
+            ("-y", [v(a.x, a.y, a.z), v(a.x, a.y, b.z), v(b.x, a.y, b.z), v(b.x, a.y, a.z)]),
+            ("+y", [v(a.x, b.y, a.z), v(b.x, b.y, a.z), v(b.x, b.y, b.z), v(a.x, b.y, b.z)]),
+            ("-z", [v(a.x, a.y, a.z), v(b.x, a.y, a.z), v(b.x, b.y, a.z), v(a.x, b.y, a.z)]),
+            ("+z", [v(a.x, a.y, b.z), v(a.x, b.y, b.z), v(b.x, b.y, b.z), v(b.x, a.y, b.z)]),
+            ("-x", [v(a.x, a.y, a.z), v(a.x, b.y, a.z), v(a.x, b.y, b.z), v(a.x, a.y, b.z)]),
+            ("+x", [v(b.x, a.y, a.z), v(b.x, a.y, b.z), v(b.x, b.y, b.z), v(b.x, b.y, a.z)]),
+        ];
+        for (name, corners) in faces {
+            if !skip.contains(&name) {
+                self.quad(corners, material);
+            }
+        }
+    }
+
+    /// The scene, with a camera.
+    pub fn scene(self, camera: Camera) -> Scene {
+        let parts = SceneParts {
+            mesh: self.mesh,
+            point_lights: self.point_lights,
+            camera,
+            two_sided: false,
+            solver: SolverDefaults::default(),
+        };
+        Scene::from_parts("test scene", parts).unwrap_or_else(|e| panic!("{e}"))
+    }
+}
+
+/// A small camera.
+pub fn camera(position: Vec3, look_at: Vec3, size: u32) -> Camera {
+    Camera { position, look_at, up: Vec3::Y, fov_y: 60.0, width: size, height: size }
+}
+
+/// Every backend in this build.
+pub fn backends() -> Vec<Backend> {
+    Backend::available()
+}
