@@ -11,10 +11,10 @@
 //! denser samples instead of hundreds of samples within 2ε (which would smear areas and cost
 //! O(samples²) per cell).
 
-use glam::Vec2;
+use glam::{DVec3, Vec2};
 
 use crate::error::Result;
-use crate::sampling::{surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
+use crate::sampling::{surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::visibility::Visibility;
 
 /// What the area computation did.
@@ -49,6 +49,9 @@ pub fn compute(
         count[side as usize] += 1;
     }
     let mut area = vec![0.0f64; samples.len()];
+    // Every share, (sample, cell, area): the regions that carry the near-field form factors.
+    let mut shares: Vec<(u32, u32, f32)> = Vec::new();
+    let mut all_cells: Vec<AreaCell> = Vec::new();
     let mut near = Vec::new();
     let mut cells: Vec<(u64, f64, Vec2)> = Vec::new();
     for side in 0..sides {
@@ -58,8 +61,15 @@ pub fn compute(
         let map = &maps[surface_of(side as u32) as usize];
         let cell = cell_size(map, epsilon.min(smallest[side]), count[side]);
         clip_cells(map, cell, &mut cells);
+
         stats.cells += cells.len();
         for &(_, a, centroid) in &cells {
+            let id = all_cells.len() as u32;
+            all_cells.push(AreaCell {
+                centroid: map.to_3d(centroid),
+                area: a as f32,
+                half: 0.5 * cell,
+            });
             let Some(nearest) = index.nearest(samples, side as u32, centroid) else {
                 continue;
             };
@@ -82,7 +92,9 @@ pub fn compute(
                     point,
                     &mut near,
                 )?;
-                area[near.first().map_or(nearest, |n| n.0) as usize] += a;
+                let k = near.first().map_or(nearest, |n| n.0);
+                area[k as usize] += a;
+                shares.push((k, id, a as f32));
                 continue;
             }
             // Ascending sample order: the sum does not depend on the grid's iteration order.
@@ -90,9 +102,36 @@ pub fn compute(
             let weight = |d2: f32| f64::from((-alpha * d2.sqrt() / r).exp());
             let total: f64 = near.iter().map(|&(_, d2)| weight(d2)).sum();
             for &(k, d2) in &near {
-                area[k as usize] += a * weight(d2) / total;
+                let share = a * weight(d2) / total;
+                area[k as usize] += share;
+                shares.push((k, id, share as f32));
             }
         }
+    }
+    // Group the shares by sample (stable: in cell order within each sample).
+    shares.sort_by_key(|&(k, _, _)| k);
+    let n = samples.len();
+    samples.share_start = vec![0; n + 1];
+    for &(k, _, _) in &shares {
+        samples.share_start[k as usize + 1] += 1;
+    }
+    for k in 0..n {
+        samples.share_start[k + 1] += samples.share_start[k];
+    }
+    samples.shares = shares.into_iter().map(|(_, c, a)| (c, a)).collect();
+    samples.cells = all_cells;
+    for k in 0..n {
+        let mut mass = 0.0f64;
+        let mut sum = DVec3::ZERO;
+        for &(c, a) in samples.shares_of(k) {
+            mass += f64::from(a);
+            sum += f64::from(a) * samples.cells[c as usize].centroid.as_dvec3();
+        }
+        samples.centroid[k] = if mass > 0.0 {
+            (sum / mass).as_vec3()
+        } else {
+            samples.position[k]
+        };
     }
     samples.area = area;
     Ok(stats)

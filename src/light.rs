@@ -257,14 +257,20 @@ impl DirectLight {
 /// Irradiance at x (normal n) from a triangle of unit radiance emitting towards x: Lambert's
 /// formula E = ½ Σ θ_i (n · Γ_i) over the triangle clipped to the half-space above x's plane.
 pub fn polygon_irradiance(t: &[Vec3; 3], x: Vec3, n: Vec3) -> f64 {
+    convex_polygon_irradiance(t, x, n)
+}
+
+/// Lambert's formula for a convex polygon of up to 8 vertices (see [`polygon_irradiance`]).
+pub fn convex_polygon_irradiance(polygon: &[Vec3], x: Vec3, n: Vec3) -> f64 {
     let n = n.as_dvec3();
     let x = x.as_dvec3();
-    // Clip to n · (p − x) ≥ 0 (Sutherland–Hodgman; a triangle gives at most 4 vertices).
-    let mut poly: [DVec3; 4] = [DVec3::ZERO; 4];
+    // Clip to n · (p − x) ≥ 0 (Sutherland–Hodgman: one more vertex at most).
+    let mut poly = [DVec3::ZERO; 9];
     let mut len = 0;
-    for i in 0..3 {
-        let a = t[i].as_dvec3() - x;
-        let b = t[(i + 1) % 3].as_dvec3() - x;
+    let m = polygon.len().min(8);
+    for i in 0..m {
+        let a = polygon[i].as_dvec3() - x;
+        let b = polygon[(i + 1) % m].as_dvec3() - x;
         let (da, db) = (n.dot(a), n.dot(b));
         if da >= 0.0 {
             poly[len] = a;
@@ -281,13 +287,9 @@ pub fn polygon_irradiance(t: &[Vec3; 3], x: Vec3, n: Vec3) -> f64 {
     let mut sum = 0.0;
     for i in 0..len {
         let (a, b) = (poly[i], poly[(i + 1) % len]);
-        let (la, lb) = (a.length(), b.length());
-        if la <= 0.0 || lb <= 0.0 {
-            continue;
-        }
         let cross = a.cross(b);
         let cl = cross.length();
-        if cl <= 0.0 {
+        if cl <= 0.0 || a.length_squared() <= 0.0 || b.length_squared() <= 0.0 {
             continue;
         }
         let theta = cl.atan2(a.dot(b));

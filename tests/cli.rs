@@ -22,11 +22,11 @@ fn info_summarises_the_room() {
     for expected in [
         "triangles     34",
         "surfaces      17",
-        "total area    221.05",
+        "total area    298.05",
         "area lights   1 surface(s), area 1.440000, power 45.2389 45.2389 45.2389 W",
         "point lights  0",
-        "fov_y 60°, 512x512",
-        "(diagonal 9.526",
+        "fov_y 62°, 512x512",
+        "(diagonal 11.895",
     ] {
         assert!(
             stdout.contains(expected),
@@ -115,5 +115,104 @@ fn gallery_generator_writes_a_loadable_reduced_gallery() {
         text(&out.stdout).contains("point lights  8"),
         "{}",
         text(&out.stdout)
+    );
+}
+
+#[test]
+fn render_writes_exr_and_png_and_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("box.exr");
+    let run = meshlight(&[
+        "render",
+        "scenes/box/scene.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let stdout = text(&run.stdout);
+    for expected in [
+        "round",
+        "samples",
+        "converged",
+        "render 128x128",
+        "ε 0.1 (scene file)",
+    ] {
+        assert!(
+            stdout.contains(expected),
+            "missing '{expected}' in:\n{stdout}"
+        );
+    }
+    let image = meshlight::Image::read_exr(&out).unwrap();
+    assert!(
+        (image.mean() - 0.2).abs() < 0.002,
+        "furnace mean {}",
+        image.mean()
+    );
+    assert!(out.with_extension("png").exists());
+}
+
+#[test]
+fn samples_writes_a_ply_point_cloud() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.ply");
+    let run = meshlight(&[
+        "samples",
+        "scenes/box/scene.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--preset",
+        "preview",
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let ply = std::fs::read_to_string(&out).unwrap();
+    let count: usize = ply
+        .lines()
+        .find_map(|l| l.strip_prefix("element vertex "))
+        .and_then(|n| n.parse().ok())
+        .expect("a vertex count");
+    let body: Vec<&str> = ply
+        .lines()
+        .skip_while(|l| *l != "end_header")
+        .skip(1)
+        .collect();
+    assert_eq!(body.len(), count);
+    assert!(count > 100);
+    assert_eq!(
+        body[0].split_whitespace().count(),
+        11,
+        "x y z nx ny nz r g b radius area"
+    );
+}
+
+#[test]
+fn no_epsilon_means_an_automatic_one_that_is_announced() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy("scenes/box/box.obj", dir.path().join("box.obj")).unwrap();
+    std::fs::copy("scenes/box/box.mtl", dir.path().join("box.mtl")).unwrap();
+    let toml = std::fs::read_to_string("scenes/box/scene.toml")
+        .unwrap()
+        .replace("[solver]\nepsilon = 0.1\n", "");
+    std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
+    let out = dir.path().join("a.exr");
+    let run = meshlight(&[
+        "render",
+        dir.path().join("scene.toml").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--rounds",
+        "0",
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert!(
+        text(&run.stderr).contains("no epsilon given: chose ε ="),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(
+        text(&run.stdout).contains("(automatic)"),
+        "{}",
+        text(&run.stdout)
     );
 }

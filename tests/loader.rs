@@ -45,7 +45,8 @@ fn room_has_walls_light_and_two_boxes() {
     // 6 walls + 1 light + 2 boxes × 5 faces (no bottoms), each face a quad of 2 triangles.
     assert_eq!(s.surfaces.len(), 6 + 1 + 10);
     assert_eq!(s.triangles.len(), 2 * 17);
-    let walls = 6.0 * 5.5 * 5.5;
+    // 5.5 m wide and high, 9 m deep.
+    let walls = 4.0 * 5.5 * 9.0 + 2.0 * 5.5 * 5.5;
     let light = 1.2 * 1.2;
     let short_box = 5.0 * 1.65 * 1.65;
     let tall_box = 4.0 * 1.65 * 3.3 + 1.65 * 1.65;

@@ -62,6 +62,18 @@ pub struct Samples {
     pub radius: Vec<f32>,
     /// Representative area S (eqs. 4-6).
     pub area: Vec<f64>,
+    /// Centroid of each sample's shares of area (its region): form factors are taken between
+    /// region centroids, since a sample's radiosity stands for its region's average.
+    pub centroid: Vec<Vec3>,
+    /// The shares of area cells each sample holds (eq. 5): sample k's are
+    /// `shares[share_start[k]..share_start[k+1]]`, each (cell index, area share). The shares of
+    /// a cell add up to the cell, so they tile the surfaces exactly; near shooters are
+    /// integrated over them.
+    pub shares: Vec<(u32, f32)>,
+    /// Offsets into `shares` (length samples + 1 once areas are computed).
+    pub share_start: Vec<u32>,
+    /// The area cells (pieces of surface).
+    pub cells: Vec<AreaCell>,
     /// The adaptive round in which each sample was added (0 = initial Poisson disk).
     pub round: Vec<u16>,
 }
@@ -90,6 +102,7 @@ impl Samples {
         self.side.push(side);
         self.radius.push(radius);
         self.area.push(0.0);
+        self.centroid.push(map.to_3d(uv));
         self.round.push(round);
     }
 
@@ -100,6 +113,28 @@ impl Samples {
             total[s as usize] += a;
         }
         total
+    }
+}
+
+/// A piece of surface: an area cell clipped to the surface, seen as the square of its area
+/// around its centroid.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AreaCell {
+    /// Centroid.
+    pub centroid: Vec3,
+    /// Area.
+    pub area: f32,
+    /// Half the side of the grid cell it was cut from.
+    pub half: f32,
+}
+
+impl Samples {
+    /// Sample k's shares of area cells: (cell index, area).
+    pub fn shares_of(&self, k: usize) -> &[(u32, f32)] {
+        match (self.share_start.get(k), self.share_start.get(k + 1)) {
+            (Some(&a), Some(&b)) => &self.shares[a as usize..b as usize],
+            _ => &[],
+        }
     }
 }
 

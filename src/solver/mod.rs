@@ -355,6 +355,7 @@ pub fn solve(
         let max_shots = options.max_shots.unwrap_or(200 * n as u64);
         let mut state = shooting::State {
             samples: &solution.samples,
+            maps: &solution.maps,
             reflectance: &reflectances,
             irradiance: &mut solution.irradiance,
             unshot: &mut solution.unshot,
@@ -427,15 +428,16 @@ pub fn solve(
 /// meshless transfer on its own, for tests and analysis.
 pub fn transfer(
     scene: &Scene,
-    samples: &Samples,
+    solution: &Solution,
     vis: &dyn Visibility,
     shooters: &[u32],
     source: DVec3,
 ) -> Result<Vec<DVec3>> {
+    let (samples, maps) = (&solution.samples, &solution.maps);
     let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
     let mut irradiance = vec![DVec3::ZERO; samples.len()];
     for &j in shooters {
-        for (i, f) in shooting::form_factors(samples, vis, lift, j as usize)? {
+        for (i, f) in shooting::form_factors(samples, maps, vis, lift, j as usize)? {
             irradiance[i as usize] += source * f64::from(f);
         }
     }

@@ -2,15 +2,19 @@
 //! parallel reinsertion (Meister & Bittner 2018), any-hit traversal with early exit for occlusion, closest hit for camera rays.
 //!
 //! The default builds with heavy reinsertion and traverses an 8-wide CWBVH: see [`BvhPreset`].
+//!
+//! Triangles are tested with the watertight algorithm of Woop, Benthin and Wald, "Watertight
+//! Ray/Triangle Intersection" (JCGT 2013): no ray slips between two triangles sharing an edge
+//! (obvhs's Möller–Trumbore test let camera rays escape a closed box at its edges).
 
 use std::time::Duration;
 
+use glam::Vec3A;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
-use obvhs::rt_triangle::RtTriangle;
 use obvhs::triangle::Triangle as ObvhsTriangle;
 use obvhs::BvhBuildParams;
 
@@ -89,9 +93,8 @@ enum Tree {
 /// An obvhs BVH over a meshlight scene's triangles.
 pub struct BvhScene {
     tree: Tree,
-    /// Triangles in the tree's primitive order, so leaves index them directly, with edges and
-    /// normal precomputed for the intersection test.
-    triangles: Vec<RtTriangle>,
+    /// Triangles in the tree's primitive order, so leaves index them directly.
+    triangles: Vec<[Vec3A; 3]>,
     /// Scene triangle index of each entry of `triangles`.
     ids: Vec<u32>,
     preset: BvhPreset,
@@ -124,7 +127,10 @@ impl BvhScene {
         };
         let triangles = ids
             .iter()
-            .map(|&i| RtTriangle::from(&input[i as usize]))
+            .map(|&i| {
+                let t = &input[i as usize];
+                [t.v0, t.v1, t.v2]
+            })
             .collect();
         BvhScene {
             tree,
@@ -151,7 +157,8 @@ impl Visibility for BvhScene {
         for (s, o) in segments.iter().zip(out.iter_mut()) {
             let ray =
                 obvhs::ray::Ray::new(s.a.into(), (s.b - s.a).into(), SEGMENT_T_MIN, SEGMENT_T_MAX);
-            let intersect = |r: &obvhs::ray::Ray, id: usize| tris[id].intersect(r);
+            let test = Watertight::new(&ray);
+            let intersect = |r: &obvhs::ray::Ray, id: usize| test.intersect(&tris[id], r);
             *o = !match &self.tree {
                 Tree::Binary(bvh) => bvh.ray_traverse_miss(ray, intersect),
                 Tree::Wide(bvh) => bvh.ray_traverse_miss(ray, intersect),
@@ -166,7 +173,8 @@ impl Visibility for BvhScene {
         for (r, o) in rays.iter().zip(out.iter_mut()) {
             let ray = obvhs::ray::Ray::new(r.origin.into(), r.dir.into(), r.t_min, r.t_max);
             let mut hit = RayHit::none();
-            let intersect = |r: &obvhs::ray::Ray, id: usize| tris[id].intersect(r);
+            let test = Watertight::new(&ray);
+            let intersect = |r: &obvhs::ray::Ray, id: usize| test.intersect(&tris[id], r);
             let found = match &self.tree {
                 Tree::Binary(bvh) => bvh.ray_traverse(ray, &mut hit, intersect),
                 Tree::Wide(bvh) => bvh.ray_traverse(ray, &mut hit, intersect),
@@ -177,5 +185,87 @@ impl Visibility for BvhScene {
             });
         }
         Ok(())
+    }
+}
+
+/// Per-ray constants of the watertight test: the ray's dominant axis becomes z, and a shear
+/// maps its direction onto +z, so the edge tests are 2D and exact in sign.
+struct Watertight {
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+    origin: Vec3A,
+}
+
+impl Watertight {
+    fn new(ray: &obvhs::ray::Ray) -> Self {
+        let d = ray.direction;
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Watertight {
+            kx,
+            ky,
+            kz,
+            sx: d[kx] / d[kz],
+            sy: d[ky] / d[kz],
+            sz: 1.0 / d[kz],
+            origin: ray.origin,
+        }
+    }
+
+    /// Distance to the triangle within [tmin, tmax], or infinity.
+    fn intersect(&self, t: &[Vec3A; 3], ray: &obvhs::ray::Ray) -> f32 {
+        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let a = t[0] - self.origin;
+        let b = t[1] - self.origin;
+        let c = t[2] - self.origin;
+        let (ax, ay) = (a[kx] - self.sx * a[kz], a[ky] - self.sy * a[kz]);
+        let (bx, by) = (b[kx] - self.sx * b[kz], b[ky] - self.sy * b[kz]);
+        let (cx, cy) = (c[kx] - self.sx * c[kz], c[ky] - self.sy * c[kz]);
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        // Exactly on an edge in f32: decide in f64, so neighbours agree.
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            let (ax, ay, bx, by, cx, cy) = (
+                f64::from(ax),
+                f64::from(ay),
+                f64::from(bx),
+                f64::from(by),
+                f64::from(cx),
+                f64::from(cy),
+            );
+            u = (cx * by - cy * bx) as f32;
+            v = (ax * cy - ay * cx) as f32;
+            w = (bx * ay - by * ax) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return f32::INFINITY;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return f32::INFINITY;
+        }
+        let (az, bz, cz) = (self.sz * a[kz], self.sz * b[kz], self.sz * c[kz]);
+        let t_scaled = u * az + v * bz + w * cz;
+        let t = t_scaled / det;
+        if t >= ray.tmin && t <= ray.tmax && t.is_finite() {
+            t
+        } else {
+            f32::INFINITY
+        }
     }
 }

@@ -11,12 +11,19 @@ use meshlight::{Backend, Scene};
 
 /// A shipped scene's path.
 pub fn shipped(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name).join("scene.toml")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+        .join("scene.toml")
 }
 
 /// A diffuse material.
 pub fn material(name: &str, kd: f32, ke: f32) -> Material {
-    Material { name: name.into(), kd: Vec3::splat(kd), ke: Vec3::splat(ke) }
+    Material {
+        name: name.into(),
+        kd: Vec3::splat(kd),
+        ke: Vec3::splat(ke),
+    }
 }
 
 /// Builds a mesh from quads.
@@ -48,12 +55,60 @@ impl Builder {
         let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
         let (a, b) = (lo, hi);
         let faces = [
-            ("-y", [v(a.x, a.y, a.z), v(a.x, a.y, b.z), v(b.x, a.y, b.z), v(b.x, a.y, a.z)]),
-            ("+y", [v(a.x, b.y, a.z), v(b.x, b.y, a.z), v(b.x, b.y, b.z), v(a.x, b.y, b.z)]),
-            ("-z", [v(a.x, a.y, a.z), v(b.x, a.y, a.z), v(b.x, b.y, a.z), v(a.x, b.y, a.z)]),
-            ("+z", [v(a.x, a.y, b.z), v(a.x, b.y, b.z), v(b.x, b.y, b.z), v(b.x, a.y, b.z)]),
-            ("-x", [v(a.x, a.y, a.z), v(a.x, b.y, a.z), v(a.x, b.y, b.z), v(a.x, a.y, b.z)]),
-            ("+x", [v(b.x, a.y, a.z), v(b.x, a.y, b.z), v(b.x, b.y, b.z), v(b.x, b.y, a.z)]),
+            (
+                "-y",
+                [
+                    v(a.x, a.y, a.z),
+                    v(a.x, a.y, b.z),
+                    v(b.x, a.y, b.z),
+                    v(b.x, a.y, a.z),
+                ],
+            ),
+            (
+                "+y",
+                [
+                    v(a.x, b.y, a.z),
+                    v(b.x, b.y, a.z),
+                    v(b.x, b.y, b.z),
+                    v(a.x, b.y, b.z),
+                ],
+            ),
+            (
+                "-z",
+                [
+                    v(a.x, a.y, a.z),
+                    v(b.x, a.y, a.z),
+                    v(b.x, b.y, a.z),
+                    v(a.x, b.y, a.z),
+                ],
+            ),
+            (
+                "+z",
+                [
+                    v(a.x, a.y, b.z),
+                    v(a.x, b.y, b.z),
+                    v(b.x, b.y, b.z),
+                    v(b.x, a.y, b.z),
+                ],
+            ),
+            (
+                "-x",
+                [
+                    v(a.x, a.y, a.z),
+                    v(a.x, b.y, a.z),
+                    v(a.x, b.y, b.z),
+                    v(a.x, a.y, b.z),
+                ],
+            ),
+            (
+                "+x",
+                [
+                    v(b.x, a.y, a.z),
+                    v(b.x, a.y, b.z),
+                    v(b.x, b.y, b.z),
+                    v(b.x, b.y, a.z),
+                ],
+            ),
         ];
         for (name, corners) in faces {
             if !skip.contains(&name) {
@@ -77,10 +132,56 @@ impl Builder {
 
 /// A small camera.
 pub fn camera(position: Vec3, look_at: Vec3, size: u32) -> Camera {
-    Camera { position, look_at, up: Vec3::Y, fov_y: 60.0, width: size, height: size }
+    Camera {
+        position,
+        look_at,
+        up: Vec3::Y,
+        fov_y: 60.0,
+        width: size,
+        height: size,
+    }
 }
 
 /// Every backend in this build.
 pub fn backends() -> Vec<Backend> {
     Backend::available()
+}
+
+/// Two rooms side by side, sharing one solid wall 0.2 thick and one continuous floor; a point
+/// light in room A only; the camera in room B.
+pub fn two_rooms() -> Scene {
+    let mut builder = Builder::default();
+    let white = builder.material(material("white", 0.8, 0.0));
+    // Room A: x ∈ [0, 2]; room B: x ∈ [2.2, 4.2]; both y ∈ [0, 2], z ∈ [0, 2].
+    builder.room(
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(2.0, 2.0, 2.0),
+        white,
+        &["-y"],
+    );
+    builder.room(
+        Vec3::new(2.2, 0.0, 0.0),
+        Vec3::new(4.2, 2.0, 2.0),
+        white,
+        &["-y"],
+    );
+    // One floor under both rooms and the wall between them.
+    builder.quad(
+        [
+            Vec3::new(0., 0., 0.),
+            Vec3::new(0., 0., 2.),
+            Vec3::new(4.2, 0., 2.),
+            Vec3::new(4.2, 0., 0.),
+        ],
+        white,
+    );
+    builder.point_lights.push(meshlight::scene::PointLight {
+        position: Vec3::new(1.0, 1.5, 1.0),
+        intensity: Vec3::splat(5.0),
+    });
+    builder.scene(camera(
+        Vec3::new(4.0, 1.2, 1.0),
+        Vec3::new(2.2, 0.6, 1.0),
+        32,
+    ))
 }

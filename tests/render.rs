@@ -1,0 +1,71 @@
+//! Rendering: the furnace image, the dark room behind a wall, the image files.
+
+mod common;
+
+use common::{backends, shipped, two_rooms};
+use meshlight::solver::{Control, Options};
+use meshlight::{Image, RenderOptions, Scene};
+
+fn solve_and_render(scene: &Scene, backend: meshlight::Backend, options: Options) -> Image {
+    let vis = backend.build(scene).unwrap();
+    let options = Options { backend, ..options };
+    let solution =
+        meshlight::solve(scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
+    meshlight::render(scene, &solution, vis.as_ref(), &RenderOptions::default())
+        .unwrap()
+        .0
+}
+
+#[test]
+fn furnace_every_pixel_is_at_the_analytic_radiance() {
+    let scene = Scene::load(shipped("box")).unwrap();
+    for backend in backends() {
+        let image = solve_and_render(
+            &scene,
+            backend,
+            Options {
+                tolerance: 1e-5,
+                ..Options::default()
+            },
+        );
+        assert_eq!(image.pixels.len(), 128 * 128);
+        for (i, p) in image.pixels.iter().enumerate() {
+            let worst = (*p - glam::Vec3::splat(0.2)).abs().max_element() / 0.2;
+            assert!(worst < 0.01, "{backend}: pixel {i} = {p}");
+        }
+    }
+}
+
+#[test]
+fn the_room_behind_the_wall_renders_black() {
+    let scene = two_rooms();
+    for backend in backends() {
+        let image = solve_and_render(&scene, backend, Options::default());
+        // The camera stands in the dark room: every pixel is exactly zero.
+        for (i, p) in image.pixels.iter().enumerate() {
+            assert_eq!(*p, glam::Vec3::ZERO, "{backend}: pixel {i}");
+        }
+    }
+}
+
+#[test]
+fn exr_round_trip_and_png() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    let image = solve_and_render(
+        &scene,
+        meshlight::Backend::default_backend(),
+        Options::preview(),
+    );
+    assert!(image.mean() > 0.0);
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("room.exr");
+    image.write_exr(&exr).unwrap();
+    let back = Image::read_exr(&exr).unwrap();
+    assert_eq!(back, image, "EXR keeps the linear values exactly");
+    let png = dir.path().join("room.png");
+    image.write_png(&png, image.auto_exposure()).unwrap();
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    // Pixel (0, 0) is the top-left: the top of the room image is ceiling, the bottom floor.
+    let (w, h) = (image.width as usize, image.height as usize);
+    assert!(image.pixels[0].length() > 0.0 && image.pixels[w * h - 1].length() > 0.0);
+}

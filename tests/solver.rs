@@ -1,0 +1,517 @@
+//! The solver against answers known without it: the furnace, form factors of known shapes,
+//! area conservation, energy balance, the inverse-square law, no light through walls,
+//! determinism, and adaptive samples going where light changes.
+
+mod common;
+
+use common::{backends, camera, material, shipped, two_rooms, Builder};
+use glam::{DVec3, Vec3};
+use meshlight::sampling::{is_back, surface_of};
+use meshlight::scene::PointLight;
+use meshlight::solver::{transfer, Control, Options, StopReason};
+use meshlight::{Backend, Scene, Solution};
+
+fn solve(scene: &Scene, backend: Backend, options: Options) -> Solution {
+    let vis = backend.build(scene).unwrap();
+    meshlight::solve(
+        scene,
+        vis.as_ref(),
+        &Options { backend, ..options },
+        &mut |_| Control::Continue,
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn furnace_every_sample_is_at_the_analytic_radiance() {
+    // Closed cube, Kd 0.5, Ke 0.1 everywhere: L = Ke / (1 − Kd) = 0.2.
+    let scene = Scene::load(shipped("box")).unwrap();
+    for backend in backends() {
+        let s = solve(
+            &scene,
+            backend,
+            Options {
+                tolerance: 1e-5,
+                ..Options::default()
+            },
+        );
+        assert_eq!(s.stop(), StopReason::Converged);
+        let mut worst = 0.0f64;
+        for b in &s.radiosity {
+            let l = b / std::f64::consts::PI;
+            worst = worst.max((l - DVec3::splat(0.2)).abs().max_element() / 0.2);
+        }
+        assert!(
+            worst < 0.01,
+            "{backend}: worst relative error {worst:.4} over {} samples",
+            s.samples.len()
+        );
+    }
+}
+
+/// Flux arriving at the samples of `receiver` when every sample of `source` has radiosity 1,
+/// through the meshless transfer (sample to sample), on every backend.
+fn meshless_flux(scene: &Scene, source: u32, receiver: u32) -> Vec<f64> {
+    backends()
+        .into_iter()
+        .map(|backend| {
+            let vis = backend.build(scene).unwrap();
+            let s = meshlight::solve(
+                scene,
+                vis.as_ref(),
+                &Options {
+                    backend,
+                    rounds: 0,
+                    ..Options::default()
+                },
+                &mut |_| Control::Continue,
+            )
+            .unwrap();
+            let samples = &s.samples;
+            let shooters: Vec<u32> = (0..samples.len() as u32)
+                .filter(|&k| surface_of(samples.side[k as usize]) == source)
+                .collect();
+            let h = transfer(scene, &s, vis.as_ref(), &shooters, DVec3::ONE).unwrap();
+            (0..samples.len())
+                .filter(|&k| surface_of(samples.side[k]) == receiver && !is_back(samples.side[k]))
+                .map(|k| h[k].x * samples.area[k])
+                .sum()
+        })
+        .collect()
+}
+
+/// Two unit squares: `a` and `b`, both grey, no light.
+fn two_squares(a: [Vec3; 4], b: [Vec3; 4]) -> Scene {
+    let mut builder = Builder::default();
+    let grey = builder.material(material("grey", 0.5, 0.0));
+    builder.quad(a, grey);
+    builder.quad(b, grey);
+    builder.scene(camera(
+        Vec3::new(3.0, 0.5, 0.5),
+        Vec3::new(0.5, 0.5, 0.5),
+        16,
+    ))
+}
+
+#[test]
+fn form_factor_of_parallel_coaxial_unit_squares() {
+    // Unit squares at distance 1, facing each other: F = 0.1998.
+    let scene = two_squares(
+        [
+            Vec3::new(0., 0., 1.),
+            Vec3::new(0., 1., 1.),
+            Vec3::new(1., 1., 1.),
+            Vec3::new(1., 0., 1.),
+        ],
+        [
+            Vec3::new(0., 0., 0.),
+            Vec3::new(1., 0., 0.),
+            Vec3::new(1., 1., 0.),
+            Vec3::new(0., 1., 0.),
+        ],
+    );
+    assert!((scene.surfaces[0].normal - Vec3::NEG_Z).length() < 1e-6);
+    for flux in meshless_flux(&scene, 0, 1) {
+        assert!(
+            (flux - 0.1998).abs() < 0.02 * 0.1998,
+            "delivered {flux:.5}, expected 0.1998"
+        );
+    }
+}
+
+#[test]
+fn form_factor_of_perpendicular_unit_squares_sharing_an_edge() {
+    // Unit squares at a right angle along a common edge: F = 0.2000.
+    let scene = two_squares(
+        [
+            Vec3::new(0., 0., 0.),
+            Vec3::new(0., 1., 0.),
+            Vec3::new(0., 1., 1.),
+            Vec3::new(0., 0., 1.),
+        ],
+        [
+            Vec3::new(0., 0., 0.),
+            Vec3::new(1., 0., 0.),
+            Vec3::new(1., 1., 0.),
+            Vec3::new(0., 1., 0.),
+        ],
+    );
+    for flux in meshless_flux(&scene, 0, 1) {
+        assert!(
+            (flux - 0.2).abs() < 0.02 * 0.2,
+            "delivered {flux:.5}, expected 0.2000"
+        );
+    }
+}
+
+#[test]
+fn direct_light_from_an_area_light_delivers_its_form_factor() {
+    // The upper square emits Ke = 1 (radiosity π) and reflects nothing; the lower one
+    // receives π·F·A = π·0.1998.
+    let mut builder = Builder::default();
+    let light = builder.material(material("light", 0.0, 1.0));
+    let grey = builder.material(material("grey", 0.5, 0.0));
+    builder.quad(
+        [
+            Vec3::new(0., 0., 1.),
+            Vec3::new(0., 1., 1.),
+            Vec3::new(1., 1., 1.),
+            Vec3::new(1., 0., 1.),
+        ],
+        light,
+    );
+    builder.quad(
+        [
+            Vec3::new(0., 0., 0.),
+            Vec3::new(1., 0., 0.),
+            Vec3::new(1., 1., 0.),
+            Vec3::new(0., 1., 0.),
+        ],
+        grey,
+    );
+    let scene = builder.scene(camera(
+        Vec3::new(3.0, 0.5, 0.5),
+        Vec3::new(0.5, 0.5, 0.5),
+        16,
+    ));
+    for backend in backends() {
+        let s = solve(
+            &scene,
+            backend,
+            Options {
+                rounds: 0,
+                ..Options::default()
+            },
+        );
+        let flux: f64 = (0..s.samples.len())
+            .map(|k| s.direct[k].irradiance.x * s.samples.area[k])
+            .sum();
+        let expected = std::f64::consts::PI * 0.1998;
+        assert!(
+            (flux - expected).abs() < 0.02 * expected,
+            "{backend}: {flux:.5} vs {expected:.5}"
+        );
+    }
+}
+
+#[test]
+fn areas_are_conserved_per_surface_also_after_adaptive_rounds() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    let s = solve(
+        &scene,
+        Backend::default_backend(),
+        Options {
+            rounds: 2,
+            ..Options::default()
+        },
+    );
+    assert!(
+        s.rounds.len() >= 2 && s.rounds[1].added > 0,
+        "adaptive rounds added samples"
+    );
+    let per_side = s.samples.area_per_side(2 * scene.surfaces.len());
+    for (side, &area) in per_side.iter().enumerate() {
+        if area > 0.0 {
+            let expected = scene.surfaces[side / 2].area;
+            assert!(
+                (area - expected).abs() <= 1e-3 * expected,
+                "side {side}: {area} vs {expected}"
+            );
+        }
+    }
+    assert!(s.samples.area.iter().all(|&a| a >= 0.0));
+}
+
+/// An open scene: a 4 m × 4 m floor and a 4 m × 2 m wall along one edge, a point light.
+fn open_scene() -> Scene {
+    let mut builder = Builder::default();
+    let floor = builder.material(material("floor", 0.5, 0.0));
+    let wall = builder.material(material("wall", 0.8, 0.0));
+    builder.quad(
+        [
+            Vec3::new(0., 0., 0.),
+            Vec3::new(0., 0., 4.),
+            Vec3::new(4., 0., 4.),
+            Vec3::new(4., 0., 0.),
+        ],
+        floor,
+    );
+    builder.quad(
+        [
+            Vec3::new(0., 0., 0.),
+            Vec3::new(4., 0., 0.),
+            Vec3::new(4., 2., 0.),
+            Vec3::new(0., 2., 0.),
+        ],
+        wall,
+    );
+    builder.point_lights.push(PointLight {
+        position: Vec3::new(1.5, 1.5, 1.0),
+        intensity: Vec3::splat(10.0),
+    });
+    builder.scene(camera(
+        Vec3::new(2.0, 1.5, 6.0),
+        Vec3::new(2.0, 0.5, 0.0),
+        16,
+    ))
+}
+
+/// Solid angle of the rectangle [x0, x1] × [z0, z1] of the plane at distance h from a point
+/// straight above the origin (sum over corners of atan(x z / (h √(h² + x² + z²)))).
+fn rectangle_solid_angle(x0: f64, x1: f64, z0: f64, z1: f64, h: f64) -> f64 {
+    let f = |x: f64, z: f64| (x * z / (h * (h * h + x * x + z * z).sqrt())).atan();
+    f(x1, z1) - f(x0, z1) - f(x1, z0) + f(x0, z0)
+}
+
+#[test]
+fn energy_balance_in_an_open_scene() {
+    let scene = open_scene();
+    for backend in backends() {
+        let s = solve(
+            &scene,
+            backend,
+            Options {
+                rounds: 0,
+                tolerance: 1e-6,
+                ..Options::default()
+            },
+        );
+        let emitted = s.ledger.emitted.x;
+        let absorbed = s.absorbed(&scene).x;
+        let escaped = s.ledger.escaped.x;
+        let unshot = s.unshot_power().x;
+        let balance = (absorbed + escaped + unshot - emitted).abs() / emitted;
+        assert!(balance < 1e-3, "{backend}: emitted {emitted} vs absorbed {absorbed} + escaped {escaped} + unshot {unshot}");
+        assert!(
+            escaped > 0.5 * emitted,
+            "most light leaves an open scene: {escaped} of {emitted}"
+        );
+
+        // Independently: the direct flux on the floor is I × its solid angle from the light.
+        let floor_flux: f64 = (0..s.samples.len())
+            .filter(|&k| surface_of(s.samples.side[k]) == 0)
+            .map(|k| s.direct[k].irradiance.x * s.samples.area[k])
+            .sum();
+        let exact = 10.0 * rectangle_solid_angle(-1.5, 2.5, -1.0, 3.0, 1.5);
+        assert!(
+            (floor_flux - exact).abs() < 2e-3 * exact,
+            "{backend}: floor flux {floor_flux} vs {exact}"
+        );
+    }
+}
+
+#[test]
+fn point_light_over_a_large_plane_follows_the_inverse_square_law() {
+    let mut builder = Builder::default();
+    let grey = builder.material(material("grey", 0.4, 0.0));
+    builder.quad(
+        [
+            Vec3::new(-10., 0., -10.),
+            Vec3::new(-10., 0., 10.),
+            Vec3::new(10., 0., 10.),
+            Vec3::new(10., 0., -10.),
+        ],
+        grey,
+    );
+    let light = Vec3::new(1.0, 2.0, -0.5);
+    builder.point_lights.push(PointLight {
+        position: light,
+        intensity: Vec3::new(5.0, 10.0, 20.0),
+    });
+    let scene = builder.scene(camera(Vec3::new(0.0, 5.0, 12.0), Vec3::ZERO, 16));
+    let s = solve(
+        &scene,
+        Backend::default_backend(),
+        Options {
+            rounds: 0,
+            ..Options::default()
+        },
+    );
+    assert!(s.samples.len() > 1000);
+    for k in 0..s.samples.len() {
+        let d = light - s.samples.position[k];
+        let expected =
+            f64::from(d.y / d.length() / d.length_squared()) * DVec3::new(5.0, 10.0, 20.0);
+        let got = s.direct[k].irradiance;
+        assert!(
+            (got - expected).abs().max_element() <= 0.01 * expected.max_element(),
+            "sample {k}: {got} vs {expected}"
+        );
+    }
+}
+
+#[test]
+fn no_light_leaks_through_a_shared_wall() {
+    let scene = two_rooms();
+    for backend in backends() {
+        let s = solve(
+            &scene,
+            backend,
+            Options {
+                rounds: 2,
+                ..Options::default()
+            },
+        );
+        let (mut dark, mut lit) = (0, 0);
+        for k in 0..s.samples.len() {
+            let x = s.samples.position[k].x;
+            if x > 2.2 {
+                assert_eq!(
+                    s.radiosity[k],
+                    DVec3::ZERO,
+                    "{backend}: sample {k} at {} in the dark room",
+                    s.samples.position[k]
+                );
+                dark += 1;
+            } else if x < 2.0 && s.radiosity[k].x > 0.0 {
+                lit += 1;
+            }
+        }
+        assert!(dark > 100 && lit > 100, "{dark} dark, {lit} lit samples");
+    }
+}
+
+#[test]
+fn one_or_two_threads_give_bit_identical_radiosity() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    let one = solve(
+        &scene,
+        Backend::default_backend(),
+        Options {
+            threads: 1,
+            ..Options::default()
+        },
+    );
+    let two = solve(
+        &scene,
+        Backend::default_backend(),
+        Options {
+            threads: 2,
+            ..Options::default()
+        },
+    );
+    assert_eq!(one.samples, two.samples);
+    assert!(
+        one.radiosity == two.radiosity,
+        "radiosity differs between 1 and 2 threads"
+    );
+}
+
+#[test]
+fn embree_and_obvhs_give_the_same_radiosity() {
+    if backends().len() < 2 {
+        return;
+    }
+    let scene = Scene::load(shipped("room")).unwrap();
+    let options = Options {
+        rounds: 0,
+        ..Options::default()
+    };
+    let a = solve(&scene, Backend::Embree, options.clone());
+    let b = solve(&scene, Backend::Bvh, options);
+    assert_eq!(a.samples, b.samples);
+    let mean =
+        a.radiosity.iter().map(|b| b.element_sum()).sum::<f64>() / (3 * a.radiosity.len()) as f64;
+    for (k, (x, y)) in a.radiosity.iter().zip(&b.radiosity).enumerate() {
+        let scale = x.abs().max(*y).max_element().max(mean);
+        assert!(
+            (*x - *y).abs().max_element() <= 1e-4 * scale,
+            "sample {k}: {x} vs {y}"
+        );
+    }
+}
+
+#[test]
+fn adaptive_rounds_put_samples_at_shadow_boundaries() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    let s = solve(&scene, Backend::default_backend(), Options::default());
+    let initial: Vec<usize> = (0..s.samples.len())
+        .filter(|&k| s.samples.round[k] == 0)
+        .collect();
+    // Penumbra: initial samples that see part of the light; the rest are fully lit or dark.
+    let penumbra: Vec<usize> = initial
+        .iter()
+        .copied()
+        .filter(|&k| s.direct[k].visible > 0.02 && s.direct[k].visible < 0.98)
+        .collect();
+    let other: Vec<usize> = initial
+        .iter()
+        .copied()
+        .filter(|&k| !penumbra.contains(&k))
+        .collect();
+    // Samples now within ε of those initial samples, per initial sample.
+    let eps2 = s.epsilon * s.epsilon;
+    let density = |group: &[usize]| -> f64 {
+        let count: usize = group
+            .iter()
+            .map(|&g| {
+                (0..s.samples.len())
+                    .filter(|&k| {
+                        s.samples.side[k] == s.samples.side[g]
+                            && s.samples.position[k].distance_squared(s.samples.position[g]) < eps2
+                    })
+                    .count()
+            })
+            .sum();
+        count as f64 / group.len() as f64
+    };
+    let (near_shadow, elsewhere) = (density(&penumbra), density(&other));
+    assert!(penumbra.len() > 20, "{} penumbra samples", penumbra.len());
+    assert!(
+        near_shadow > 2.0 * elsewhere,
+        "samples per ε-disc: {near_shadow:.2} near shadow boundaries vs {elsewhere:.2} elsewhere"
+    );
+}
+
+#[test]
+fn a_dark_scene_is_all_zero_and_says_so() {
+    let mut builder = Builder::default();
+    let grey = builder.material(material("grey", 0.5, 0.0));
+    builder.room(Vec3::ZERO, Vec3::ONE, grey, &[]);
+    let scene = builder.scene(camera(Vec3::splat(0.5), Vec3::new(0.5, 0.5, 1.0), 8));
+    let s = solve(&scene, Backend::default_backend(), Options::default());
+    assert_eq!(s.stop(), StopReason::NoLight);
+    assert!(s.radiosity.iter().all(|b| *b == DVec3::ZERO));
+}
+
+#[test]
+fn a_stopped_solve_returns_its_current_estimate() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    let mut reports = 0;
+    let s = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |p| {
+        reports += 1;
+        if p.shots >= 64 {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    })
+    .unwrap();
+    assert_eq!(s.stop(), StopReason::Stopped);
+    assert_eq!(s.rounds.len(), 1);
+    assert!(
+        s.rounds[0].shooting.shots == 64,
+        "{}",
+        s.rounds[0].shooting.shots
+    );
+    assert!(s.radiosity.iter().any(|b| b.x > 0.0));
+    assert!(reports > 3);
+}
+
+#[test]
+fn too_small_an_epsilon_is_refused_before_allocating() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    let options = Options {
+        epsilon: Some(1e-4),
+        ..Options::default()
+    };
+    let e = meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("would place about") && e.contains("--max-samples"),
+        "{e}"
+    );
+}
