@@ -6,17 +6,25 @@
 //! The data flows scene → visibility → samples → areas → solver → render:
 //!
 //! ```no_run
-//! use meshlight::{Backend, Scene};
+//! use meshlight::solver::{Control, Options};
+//! use meshlight::{Backend, RenderOptions, Scene};
 //!
 //! let scene = Scene::load("scenes/room/scene.toml")?;
-//! let visibility = Backend::default_backend().build(&scene)?;
-//! println!("{} triangles on {} surfaces", scene.triangles.len(), scene.surfaces.len());
+//! let vis = Backend::default_backend().build(&scene)?;
+//! let options = Options { rounds: 1, ..Options::default() };
+//! let solution = meshlight::solve(&scene, vis.as_ref(), &options, &mut |progress| {
+//!     // Stop ends the solve at the next shot; the estimate so far can be rendered.
+//!     if progress.shots > 100_000 { Control::Stop } else { Control::Continue }
+//! })?;
+//! let (image, _stats) = meshlight::render(&scene, &solution, vis.as_ref(), &RenderOptions::default())?;
+//! image.write_exr("room.exr".as_ref())?;
 //! # Ok::<(), meshlight::Error>(())
 //! ```
 
 pub mod area;
 pub mod error;
 pub mod light;
+pub mod metrics;
 mod parallel;
 pub mod ply;
 pub mod render;

@@ -73,6 +73,13 @@ enum Command {
         #[arg(long, default_value_t = 4)]
         supersample: u32,
     },
+    /// Compare an image with a reference: mean absolute error / mean (the paper's measure) and more.
+    Compare {
+        /// The image to judge (.exr).
+        image: PathBuf,
+        /// The reference (.exr).
+        reference: PathBuf,
+    },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
     Samples {
         #[command(flatten)]
@@ -157,6 +164,23 @@ fn run(args: Args) -> anyhow::Result<()> {
                 started.elapsed().as_secs_f64(),
                 output.display(),
                 png.display()
+            );
+        }
+        Command::Compare { image, reference } => {
+            let a = meshlight::Image::read_exr(&image)?;
+            let b = meshlight::Image::read_exr(&reference)?;
+            let e = meshlight::metrics::compare(&a, &b)?;
+            println!("MAE/mean {:.5}", e.mae_over_mean);
+            println!("RMSE/mean {:.5}", e.rmse_over_mean);
+            println!("p99 error/mean {:.5}", e.p99_over_mean);
+            println!(
+                "mean {:.5} {:.5} {:.5} vs reference {:.5} {:.5} {:.5}",
+                e.mean[0],
+                e.mean[1],
+                e.mean[2],
+                e.reference_mean[0],
+                e.reference_mean[1],
+                e.reference_mean[2]
             );
         }
         Command::Samples { solve, output } => {
