@@ -459,3 +459,173 @@ fn host_built_scenes_are_checked_too() {
         .to_string();
     assert!(e.starts_with("host: material 'm': Kd"), "{e}");
 }
+
+#[test]
+fn hostile_numbers_are_refused() {
+    let obj = OBJ.replace("v 1 1 0", "v 1 1e38 0");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:4:",
+        "too large",
+    );
+    let obj = OBJ.replace("v 1 1 0", "v 1 1e39 0");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:4:",
+        "NaN or infinite",
+    );
+    let obj = OBJ.replace("f 1 2 3 4", "f 1 2 3 2147483648");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:7:",
+        "vertex index 2147483648 is out of range",
+    );
+    let obj = OBJ.replace("f 1 2 3 4", "f 1 2 3 99999999999999999999999");
+    assert_names(
+        &error(Files {
+            obj: &obj,
+            ..Files::default()
+        }),
+        "s.obj:7:",
+        "does not start with a vertex index",
+    );
+    let toml = TOML.replace("width = 32", "width = 100000000000");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:7:",
+        "invalid value",
+    );
+    let toml = TOML.replace("width = 32", "width = 40000");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:3:",
+        "too large",
+    );
+    let toml = TOML.replace("fov_y = 40.0", "fov_y = 1e300");
+    assert_names(
+        &error(Files {
+            toml: &toml,
+            ..Files::default()
+        }),
+        "scene.toml:3:",
+        "fov_y = inf",
+    );
+    let mtl = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5 0.5\nKe 1e39 0 0");
+    assert_names(
+        &error(Files {
+            mtl: &mtl,
+            ..Files::default()
+        }),
+        "s.mtl:3:",
+        "not a finite number",
+    );
+}
+
+#[test]
+fn truncated_files_are_errors_not_panics() {
+    let toml = &TOML[..TOML.find("fov_y").unwrap() + 3];
+    assert_names(
+        &error(Files {
+            toml,
+            ..Files::default()
+        }),
+        "scene.toml:6:",
+        "",
+    );
+    let toml = "obj = \"s.o";
+    assert_names(
+        &error(Files {
+            toml,
+            ..Files::default()
+        }),
+        "scene.toml:1:",
+        "",
+    );
+    let obj = &OBJ[..OBJ.find("v 1 1 0").unwrap() + 5];
+    assert_names(
+        &error(Files {
+            obj,
+            ..Files::default()
+        }),
+        "s.obj:4:",
+        "vertex needs three numbers",
+    );
+    let mtl = &MTL[..MTL.len() - 4];
+    assert_names(
+        &error(Files {
+            mtl,
+            ..Files::default()
+        }),
+        "s.mtl:2:",
+        "Kd needs three numbers",
+    );
+    // A face cut to two vertices is a line, not a face: ignored, and said.
+    let obj = OBJ.replace("f 1 2 3 4", "f 1 2 3 4\nf 1 2");
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::load(write(
+        dir.path(),
+        &Files {
+            obj: &obj,
+            ..Files::default()
+        },
+    ))
+    .unwrap();
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("ignored 1 face with fewer than 3 vertices")),
+        "{:?}",
+        scene.warnings
+    );
+}
+
+#[test]
+fn utf8_errors_name_their_line_in_every_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), &Files::default());
+    std::fs::write(
+        dir.path().join("s.mtl"),
+        b"newmtl white\nKd 0.5 0.5 0.5\n# caf\xe9\n",
+    )
+    .unwrap();
+    let e = Scene::load(&path).unwrap_err().to_string();
+    assert!(e.contains("s.mtl:3: not valid UTF-8"), "{e}");
+    std::fs::write(
+        dir.path().join("scene.toml"),
+        b"obj = \"s.obj\"\n\xc3\x28\n",
+    )
+    .unwrap();
+    let e = Scene::load(&path).unwrap_err().to_string();
+    assert!(e.contains("scene.toml:2: not valid UTF-8"), "{e}");
+}
+
+#[test]
+fn scenes_load_from_memory_too() {
+    use meshlight::scene::Memory;
+    let files = Memory::default()
+        .with("scene.toml", TOML)
+        .with("s.obj", OBJ)
+        .with("s.mtl", MTL);
+    let scene = Scene::load_from(&files, "scene.toml").unwrap();
+    assert_eq!(scene.triangles.len(), 2);
+    let e = Scene::load_from(&Memory::default().with("scene.toml", TOML), "scene.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("s.obj: cannot read"), "{e}");
+}

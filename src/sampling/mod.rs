@@ -255,6 +255,17 @@ impl SideIndex {
 
     /// The nearest sample of `side` to `uv` (searching outwards), if the side has any.
     pub fn nearest(&self, samples: &Samples, side: Side, uv: Vec2) -> Option<u32> {
+        self.nearest_where(samples, side, uv, |_| true)
+    }
+
+    /// The nearest sample of `side` to `uv` among those `keep` accepts.
+    pub fn nearest_where(
+        &self,
+        samples: &Samples,
+        side: Side,
+        uv: Vec2,
+        keep: impl Fn(u32) -> bool,
+    ) -> Option<u32> {
         let g = (*self.grids.get(side as usize)?)?;
         let mut r = g.cell;
         let reach = g.cell * (g.nx.max(g.ny) as f32 + 2.0);
@@ -262,7 +273,7 @@ impl SideIndex {
             let mut best: Option<(f32, u32)> = None;
             self.for_each_near(side, uv, r, |k| {
                 let d2 = samples.uv[k as usize].distance_squared(uv);
-                if best.is_none_or(|(b, bk)| d2 < b || (d2 == b && k < bk)) {
+                if keep(k) && best.is_none_or(|(b, bk)| d2 < b || (d2 == b && k < bk)) {
                     best = Some((d2, k));
                 }
             });

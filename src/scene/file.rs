@@ -67,8 +67,8 @@ pub(crate) fn line_of(text: &str, offset: usize) -> usize {
 }
 
 /// Reads and checks a scene file.
-pub(super) fn read(path: &Path) -> Result<SceneFile> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Read {
+pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> {
+    let bytes = files.read(path).map_err(|source| Error::Read {
         path: path.into(),
         source,
     })?;

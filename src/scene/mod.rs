@@ -5,6 +5,7 @@
 mod camera;
 mod file;
 mod obj;
+mod source;
 mod surfaces;
 mod validate;
 
@@ -15,6 +16,7 @@ use glam::{DVec3, Vec3};
 
 use crate::error::{Error, Result};
 pub use camera::Camera;
+pub use source::{Disk, Memory, Source};
 
 /// A diffuse material: reflectance and emitted radiance, RGB.
 #[derive(Clone, Debug, PartialEq)]
@@ -175,9 +177,15 @@ pub struct Scene {
 impl Scene {
     /// Loads a scene file (TOML) and the OBJ/MTL it points at.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
+        Scene::load_from(&Disk, path)
+    }
+
+    /// Loads a scene whose files come from `files` (paths as the scene file names them,
+    /// relative to its folder).
+    pub fn load_from(files: &dyn Source, path: impl AsRef<Path>) -> Result<Scene> {
         let path = path.as_ref();
-        let file = file::read(path)?;
-        let (mesh, mut warnings) = obj::read(&file.obj)?;
+        let file = file::read(files, path)?;
+        let (mesh, mut warnings) = obj::read(files, &file.obj)?;
         let parts = SceneParts {
             mesh,
             point_lights: file.point_lights,
@@ -238,6 +246,45 @@ impl Scene {
             bounds,
             warnings,
         })
+    }
+
+    /// The same scene in other units: every length × `s`, point-light intensities × s² (so
+    /// irradiance at scaled distances is unchanged) and ε × s. Radiances (Ke) stay, so a
+    /// solve gives the same image.
+    pub fn scaled(&self, s: f32) -> Scene {
+        let mut scene = self.clone();
+        for t in &mut scene.triangles {
+            t.vertices = t.vertices.map(|v| v * s);
+            t.area *= s * s;
+        }
+        for surface in &mut scene.surfaces {
+            surface.offset *= s;
+            surface.area *= f64::from(s) * f64::from(s);
+        }
+        for light in &mut scene.point_lights {
+            light.position *= s;
+            light.intensity *= s * s;
+        }
+        scene.camera.position *= s;
+        scene.camera.look_at *= s;
+        scene.bounds = Bounds {
+            min: self.bounds.min * s,
+            max: self.bounds.max * s,
+        };
+        scene.solver.epsilon = self.solver.epsilon.map(|e| e * s);
+        scene
+    }
+
+    /// The same scene with every light × `f`: emitted radiance Ke and point-light intensities.
+    pub fn with_lights_scaled(&self, f: f32) -> Scene {
+        let mut scene = self.clone();
+        for m in &mut scene.materials {
+            m.ke *= f;
+        }
+        for light in &mut scene.point_lights {
+            light.intensity *= f;
+        }
+        scene
     }
 
     /// The material of a surface.

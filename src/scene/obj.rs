@@ -27,8 +27,8 @@ const OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
 };
 
 /// Reads an OBJ file and the MTL files it names; returns the mesh and warnings.
-pub(super) fn read(path: &Path) -> Result<(Mesh, Vec<String>)> {
-    let text = read_text(path)?;
+pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<(Mesh, Vec<String>)> {
+    let text = read_text(files, path)?;
     let prepared = prepare_obj(path, &text)?;
     let dir = path.parent().unwrap_or(Path::new(""));
 
@@ -36,7 +36,7 @@ pub(super) fn read(path: &Path) -> Result<(Mesh, Vec<String>)> {
     let failure: RefCell<Option<Error>> = RefCell::new(None);
     let loader = |name: &Path| -> tobj::MTLLoadResult {
         let mtl_path = dir.join(name);
-        let outcome = read_mtl(&mtl_path).and_then(|library| {
+        let outcome = read_mtl(files, &mtl_path).and_then(|library| {
             let loaded = tobj::load_mtl_buf(&mut library.text.as_bytes())
                 .map_err(|e| Error::scene(&mtl_path, None, format!("MTL parser: {e}")))?;
             libraries.borrow_mut().push(library);
@@ -110,8 +110,8 @@ pub(super) fn read(path: &Path) -> Result<(Mesh, Vec<String>)> {
 }
 
 /// Reads a whole file as UTF-8 text; errors name the file and, for bad UTF-8, the line.
-fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Read {
+fn read_text(files: &dyn super::Source, path: &Path) -> Result<String> {
+    let bytes = files.read(path).map_err(|source| Error::Read {
         path: path.into(),
         source,
     })?;
@@ -254,8 +254,8 @@ struct MtlLines {
     ke_line: Option<usize>,
 }
 
-fn read_mtl(path: &Path) -> Result<MtlLibrary> {
-    let text = read_text(path)?;
+fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibrary> {
+    let text = read_text(files, path)?;
     let mut out = String::with_capacity(text.len());
     let mut materials: Vec<MtlLines> = Vec::new();
     let mut seen: HashMap<String, usize> = HashMap::new();

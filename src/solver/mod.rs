@@ -125,6 +125,10 @@ pub struct Solution {
     pub index: SideIndex,
     /// Which sides other geometry stands on.
     pub obstruction: Obstruction,
+    /// Per sample: whether all its probe rays hit the scene (a closed hemisphere).
+    pub closed: Vec<bool>,
+    /// Per sample: the factor its received form factors are scaled by (row normalisation).
+    pub row_scale: Vec<f32>,
 }
 
 /// Where ε came from.
@@ -291,6 +295,8 @@ pub fn solve(
         maps,
         index: SideIndex::default(),
         obstruction,
+        closed: Vec::new(),
+        row_scale: Vec::new(),
     };
     let mut added = solution.samples.len();
     let mut refined = 0;
@@ -353,6 +359,29 @@ pub fn solve(
             .map(|k| reflectance(scene, &solution.samples, k))
             .collect();
         let max_shots = options.max_shots.unwrap_or(200 * n as u64);
+        // Which new samples see the scene all around; row scales for new samples.
+        let probes = closed_hemispheres(
+            &solution.samples,
+            first_new,
+            vis,
+            options.seed,
+            lift,
+            scene.bounds.diagonal(),
+            threads,
+        )?;
+        solution.closed.extend(probes);
+        for k in first_new..n {
+            let s = &solution.samples;
+            let scale = if round == 0 {
+                1.0
+            } else {
+                solution
+                    .index
+                    .nearest_where(s, s.side[k], s.uv[k], |j| (j as usize) < first_new)
+                    .map_or(1.0, |j| solution.row_scale[j as usize])
+            };
+            solution.row_scale.push(scale);
+        }
         let mut state = shooting::State {
             samples: &solution.samples,
             maps: &solution.maps,
@@ -360,6 +389,8 @@ pub fn solve(
             irradiance: &mut solution.irradiance,
             unshot: &mut solution.unshot,
             ledger: &mut solution.ledger,
+            row_scale: &mut solution.row_scale,
+            closed: &solution.closed,
         };
         let settings = shooting::Settings {
             threads,
@@ -367,6 +398,7 @@ pub fn solve(
             max_shots,
             lift,
             cache_bytes: options.cache_bytes,
+            prepass: round == 0,
         };
         let shoot_stats = shooting::shoot(&mut state, vis, &settings, &mut |shots, fraction| {
             report(Phase::Shooting, round, n, shots, fraction)
@@ -442,6 +474,55 @@ pub fn transfer(
         }
     }
     Ok(irradiance)
+}
+
+/// Probe rays per sample for [`closed_hemispheres`].
+const PROBES: u32 = 32;
+
+/// For samples `first..`, whether all of [`PROBES`] cosine-distributed (stratified) rays from
+/// each hit the scene. Rays, not segments: a segment ignores hits near its ends, which lets a
+/// probe from a sample beside an edge slip past the neighbouring face.
+fn closed_hemispheres(
+    samples: &Samples,
+    first: usize,
+    vis: &dyn Visibility,
+    seed: u64,
+    lift: f32,
+    diagonal: f32,
+    threads: usize,
+) -> Result<Vec<bool>> {
+    use rand::{RngExt, SeedableRng};
+    let mut out = vec![true; samples.len() - first];
+    for_chunks(&mut out, 128, threads, |start, chunk| {
+        let mut rays = Vec::with_capacity(chunk.len() * PROBES as usize);
+        for k in first + start..first + start + chunk.len() {
+            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(poisson::side_seed(seed, k as u32, 11));
+            let n = samples.normal[k];
+            let (t, b) = n.any_orthonormal_pair();
+            let from = samples.position[k] + lift * n;
+            let rows = PROBES / 4;
+            for i in 0..PROBES {
+                // Stratified over (radius², angle): cosine-weighted directions.
+                let u = ((i / 4) as f32 + rng.random::<f32>()) / rows as f32;
+                let v = ((i % 4) as f32 + rng.random::<f32>()) / 4.0;
+                let (r, phi) = (u.sqrt(), v * std::f32::consts::TAU);
+                let d = t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u).max(0.0).sqrt();
+                rays.push(crate::visibility::Ray {
+                    origin: from,
+                    dir: d,
+                    t_min: 0.0,
+                    t_max: 2.0 * diagonal,
+                });
+            }
+        }
+        let mut hits = vec![None; rays.len()];
+        vis.intersect(&rays, &mut hits)?;
+        for (o, hits) in chunk.iter_mut().zip(hits.chunks(PROBES as usize)) {
+            *o = hits.iter().all(Option::is_some);
+        }
+        Ok(())
+    })?;
+    Ok(out)
 }
 
 fn check(options: &Options) -> Result<()> {
