@@ -390,6 +390,7 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
             StopReason::ShotLimit => "shot limit",
             StopReason::Stopped => "stopped",
             StopReason::NoLight => "no light",
+            StopReason::Diverged => "DIVERGED",
             _ => "?",
         };
         let _ = writeln!(
@@ -409,6 +410,12 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
             r.seconds.direct,
             r.seconds.shooting,
             if r.capped { "  (sample budget reached)" } else { "" }
+        );
+    }
+    if s.stop() == StopReason::Diverged {
+        let _ = writeln!(
+            out,
+            "warning: the solve diverged: its unshot power grew; the image is not to be trusted"
         );
     }
     if s.stop() == StopReason::ShotLimit {

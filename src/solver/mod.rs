@@ -257,6 +257,10 @@ pub fn solve(
     // Round 0: Poisson disk on every reflecting side.
     let t = Instant::now();
     let sides = reflecting_sides(scene);
+    let mut reflecting = vec![false; 2 * scene.surfaces.len()];
+    for &side in &sides {
+        reflecting[side as usize] = true;
+    }
     let mut samples = Samples::default();
     // Stopping is honoured from the first shot on: before it there is no estimate to return.
     let _ = report(Phase::Sampling, 0, 0, 0, 1.0);
@@ -361,13 +365,13 @@ pub fn solve(
         let max_shots = options.max_shots.unwrap_or(200 * n as u64);
         // Which new samples see the scene all around; row scales for new samples.
         let probes = closed_hemispheres(
+            scene,
+            &reflecting,
             &solution.samples,
             first_new,
             vis,
-            options.seed,
+            options,
             lift,
-            scene.bounds.diagonal(),
-            threads,
         )?;
         solution.closed.extend(probes);
         for k in first_new..n {
@@ -480,18 +484,26 @@ pub fn transfer(
 const PROBES: u32 = 32;
 
 /// For samples `first..`, whether all of [`PROBES`] cosine-distributed (stratified) rays from
-/// each hit the scene. Rays, not segments: a segment ignores hits near its ends, which lets a
-/// probe from a sample beside an edge slip past the neighbouring face.
+/// each hit a reflecting surface side (one that has samples): only then do the receiver's form
+/// factors have to cover its whole hemisphere. A probe that escapes, or meets a black side (the
+/// back of a light, say), leaves the row unnormalised. Rays, not segments: a segment ignores
+/// hits near its ends, which lets a probe from a sample beside an edge slip past the
+/// neighbouring face.
 fn closed_hemispheres(
+    scene: &Scene,
+    reflecting: &[bool],
     samples: &Samples,
     first: usize,
     vis: &dyn Visibility,
-    seed: u64,
+    options: &Options,
     lift: f32,
-    diagonal: f32,
-    threads: usize,
 ) -> Result<Vec<bool>> {
     use rand::{RngExt, SeedableRng};
+    let (seed, threads, diagonal) = (
+        options.seed,
+        options.threads.max(1),
+        scene.bounds.diagonal(),
+    );
     let mut out = vec![true; samples.len() - first];
     for_chunks(&mut out, 128, threads, |start, chunk| {
         let mut rays = Vec::with_capacity(chunk.len() * PROBES as usize);
@@ -517,8 +529,18 @@ fn closed_hemispheres(
         }
         let mut hits = vec![None; rays.len()];
         vis.intersect(&rays, &mut hits)?;
-        for (o, hits) in chunk.iter_mut().zip(hits.chunks(PROBES as usize)) {
-            *o = hits.iter().all(Option::is_some);
+        for ((o, hits), rays) in chunk
+            .iter_mut()
+            .zip(hits.chunks(PROBES as usize))
+            .zip(rays.chunks(PROBES as usize))
+        {
+            *o = hits.iter().zip(rays).all(|(hit, ray)| {
+                hit.is_some_and(|h| {
+                    let t = &scene.triangles[h.triangle as usize];
+                    let side = crate::sampling::side_of(t.surface, ray.dir.dot(t.normal) > 0.0);
+                    reflecting[side as usize]
+                })
+            });
         }
         Ok(())
     })?;

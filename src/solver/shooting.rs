@@ -50,6 +50,9 @@ pub enum StopReason {
     Stopped,
     /// The scene emits no light: nothing to shoot.
     NoLight,
+    /// Unshot power grew instead of shrinking (it cannot with rows summing to at most 1 and
+    /// reflectances below 1; this guards the image against infinities all the same).
+    Diverged,
 }
 
 /// The host's answer to a progress report.
@@ -351,9 +354,11 @@ pub(crate) fn shoot(
             }
             for (i, scale) in state.row_scale.iter_mut().enumerate() {
                 let sum = sums[i];
+                // A closed row off by more than a fifth is not a discretisation error to
+                // correct (something hides what the probes saw): then only cap it.
                 *scale = if sum <= 0.0 {
                     1.0
-                } else if state.closed[i] {
+                } else if state.closed[i] && (0.8..1.25).contains(&sum) {
                     (1.0 / sum) as f32
                 } else {
                     (1.0 / sum).min(1.0) as f32
@@ -384,6 +389,10 @@ pub(crate) fn shoot(
                 }
             }
             stats.unshot_fraction = total / emitted;
+            if stats.unshot_fraction.is_nan() || stats.unshot_fraction >= 1e6 {
+                stats.stop = StopReason::Diverged;
+                break;
+            }
             if first {
                 stats.initial_unshot_fraction = stats.unshot_fraction;
                 first = false;
