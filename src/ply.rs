@@ -29,15 +29,9 @@ pub fn write_samples(solution: &Solution, path: &Path, exposure: f32) -> Result<
     for k in 0..s.len() {
         let (p, n) = (s.position[k], s.normal[k]);
         let radiance = (solution.radiosity[k] / std::f64::consts::PI).as_vec3() * exposure;
-        let c = radiance.to_array().map(|v| {
-            let v = v.clamp(0.0, 1.0);
-            let srgb = if v <= 0.003_130_8 {
-                12.92 * v
-            } else {
-                1.055 * v.powf(1.0 / 2.4) - 0.055
-            };
-            (srgb * 255.0 + 0.5) as u8
-        });
+        let c = radiance
+            .to_array()
+            .map(|v| (crate::render::image::srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8);
         writeln!(
             out,
             "{} {} {} {} {} {} {} {} {} {} {}",

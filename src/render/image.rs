@@ -91,7 +91,8 @@ impl Image {
     }
 }
 
-fn srgb(linear: f32) -> f32 {
+/// The sRGB transfer function of a linear value in [0, 1].
+pub(crate) fn srgb(linear: f32) -> f32 {
     if linear <= 0.003_130_8 {
         12.92 * linear
     } else {

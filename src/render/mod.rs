@@ -6,7 +6,7 @@
 //! one ray through the centre, and a grid of rays where the pixel straddles an edge between
 //! surfaces.
 
-mod image;
+pub(crate) mod image;
 
 use glam::Vec3;
 
