@@ -7,16 +7,12 @@ mod common;
 use common::{camera, material, shipped, Builder};
 use glam::{DVec3, Vec3};
 use meshlight::scene::PointLight;
-use meshlight::solver::{Control, Options, StopReason};
-use meshlight::{Backend, Image, RenderOptions, Scene, Solution};
+use meshlight::solver::{Options, StopReason};
+use meshlight::{Backend, Image, Scene, Solution};
 
 fn solve(scene: &Scene, options: &Options) -> (Solution, Image) {
-    let vis = Backend::default_backend().build(scene).unwrap();
-    let solution = meshlight::solve(scene, vis.as_ref(), options, &mut |_| Control::Continue)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let image = meshlight::render(scene, &solution, vis.as_ref(), &RenderOptions::default())
-        .unwrap()
-        .0;
+    let (solution, image) =
+        common::solve_and_render(scene, Backend::default_backend(), options.clone(), true);
     assert!(
         solution.radiosity.iter().all(|b| b.is_finite()),
         "radiosity is finite"

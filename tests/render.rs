@@ -3,17 +3,11 @@
 mod common;
 
 use common::{backends, shipped, two_rooms};
-use meshlight::solver::{Control, Options};
-use meshlight::{Image, RenderOptions, Scene};
+use meshlight::solver::Options;
+use meshlight::{Image, Scene};
 
 fn solve_and_render(scene: &Scene, backend: meshlight::Backend, options: Options) -> Image {
-    let vis = backend.build(scene).unwrap();
-    let options = Options { backend, ..options };
-    let solution =
-        meshlight::solve(scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
-    meshlight::render(scene, &solution, vis.as_ref(), &RenderOptions::default())
-        .unwrap()
-        .0
+    common::solve_and_render(scene, backend, options, true).1
 }
 
 #[test]

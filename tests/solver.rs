@@ -4,23 +4,12 @@
 
 mod common;
 
-use common::{backends, camera, material, shipped, two_rooms, Builder};
+use common::{backends, camera, material, shipped, solve, two_rooms, Builder};
 use glam::{DVec3, Vec3};
 use meshlight::sampling::{is_back, surface_of};
 use meshlight::scene::PointLight;
 use meshlight::solver::{transfer, Control, Options, StopReason};
-use meshlight::{Backend, Scene, Solution};
-
-fn solve(scene: &Scene, backend: Backend, options: Options) -> Solution {
-    let vis = backend.build(scene).unwrap();
-    meshlight::solve(
-        scene,
-        vis.as_ref(),
-        &Options { backend, ..options },
-        &mut |_| Control::Continue,
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-}
+use meshlight::{Backend, Scene};
 
 #[test]
 fn furnace_every_sample_is_at_the_analytic_radiance() {

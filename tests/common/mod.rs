@@ -142,6 +142,43 @@ pub fn camera(position: Vec3, look_at: Vec3, size: u32) -> Camera {
     }
 }
 
+/// Solves a scene on a backend (the options' backend is replaced).
+pub fn solve(scene: &Scene, backend: Backend, options: meshlight::Options) -> meshlight::Solution {
+    solve_and_render(scene, backend, options, false).0
+}
+
+/// Solves a scene on a backend and renders its camera view.
+pub fn solve_and_render(
+    scene: &Scene,
+    backend: Backend,
+    options: meshlight::Options,
+    render: bool,
+) -> (meshlight::Solution, meshlight::Image) {
+    let vis = backend.build(scene).unwrap();
+    let options = meshlight::Options { backend, ..options };
+    let solution = meshlight::solve(scene, vis.as_ref(), &options, &mut |_| {
+        meshlight::solver::Control::Continue
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let image = if render {
+        meshlight::render(
+            scene,
+            &solution,
+            vis.as_ref(),
+            &meshlight::RenderOptions::default(),
+        )
+        .unwrap()
+        .0
+    } else {
+        meshlight::Image {
+            width: 0,
+            height: 0,
+            pixels: Vec::new(),
+        }
+    };
+    (solution, image)
+}
+
 /// Every backend in this build.
 pub fn backends() -> Vec<Backend> {
     Backend::available()
