@@ -69,6 +69,20 @@ fn meshless_flux(scene: &Scene, source: u32, receiver: u32) -> Vec<f64> {
         .collect()
 }
 
+/// A unit square at height 1 facing down, and one at height 0 facing up: coaxial, parallel.
+const UPPER_SQUARE: [Vec3; 4] = [
+    Vec3::new(0., 0., 1.),
+    Vec3::new(0., 1., 1.),
+    Vec3::new(1., 1., 1.),
+    Vec3::new(1., 0., 1.),
+];
+const LOWER_SQUARE: [Vec3; 4] = [
+    Vec3::new(0., 0., 0.),
+    Vec3::new(1., 0., 0.),
+    Vec3::new(1., 1., 0.),
+    Vec3::new(0., 1., 0.),
+];
+
 /// Two unit squares: `a` and `b`, both grey, no light.
 fn two_squares(a: [Vec3; 4], b: [Vec3; 4]) -> Scene {
     let mut builder = Builder::default();
@@ -85,20 +99,7 @@ fn two_squares(a: [Vec3; 4], b: [Vec3; 4]) -> Scene {
 #[test]
 fn form_factor_of_parallel_coaxial_unit_squares() {
     // Unit squares at distance 1, facing each other: F = 0.1998.
-    let scene = two_squares(
-        [
-            Vec3::new(0., 0., 1.),
-            Vec3::new(0., 1., 1.),
-            Vec3::new(1., 1., 1.),
-            Vec3::new(1., 0., 1.),
-        ],
-        [
-            Vec3::new(0., 0., 0.),
-            Vec3::new(1., 0., 0.),
-            Vec3::new(1., 1., 0.),
-            Vec3::new(0., 1., 0.),
-        ],
-    );
+    let scene = two_squares(UPPER_SQUARE, LOWER_SQUARE);
     assert!((scene.surfaces[0].normal - Vec3::NEG_Z).length() < 1e-6);
     for flux in meshless_flux(&scene, 0, 1) {
         assert!(
@@ -118,12 +119,7 @@ fn form_factor_of_perpendicular_unit_squares_sharing_an_edge() {
             Vec3::new(0., 1., 1.),
             Vec3::new(0., 0., 1.),
         ],
-        [
-            Vec3::new(0., 0., 0.),
-            Vec3::new(1., 0., 0.),
-            Vec3::new(1., 1., 0.),
-            Vec3::new(0., 1., 0.),
-        ],
+        LOWER_SQUARE,
     );
     for flux in meshless_flux(&scene, 0, 1) {
         assert!(
@@ -140,24 +136,8 @@ fn direct_light_from_an_area_light_delivers_its_form_factor() {
     let mut builder = Builder::default();
     let light = builder.material(material("light", 0.0, 1.0));
     let grey = builder.material(material("grey", 0.5, 0.0));
-    builder.quad(
-        [
-            Vec3::new(0., 0., 1.),
-            Vec3::new(0., 1., 1.),
-            Vec3::new(1., 1., 1.),
-            Vec3::new(1., 0., 1.),
-        ],
-        light,
-    );
-    builder.quad(
-        [
-            Vec3::new(0., 0., 0.),
-            Vec3::new(1., 0., 0.),
-            Vec3::new(1., 1., 0.),
-            Vec3::new(0., 1., 0.),
-        ],
-        grey,
-    );
+    builder.quad(UPPER_SQUARE, light);
+    builder.quad(LOWER_SQUARE, grey);
     let scene = builder.scene(camera(
         Vec3::new(3.0, 0.5, 0.5),
         Vec3::new(0.5, 0.5, 0.5),
