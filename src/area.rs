@@ -184,7 +184,7 @@ fn clip_cells(map: &SurfaceMap, cell: f32, out: &mut Vec<(u64, f64, Vec2)>) {
 }
 
 /// Sutherland–Hodgman clipping of a convex polygon to an axis-aligned box.
-fn clip_to_box(poly: &mut Vec<Vec2>, scratch: &mut Vec<Vec2>, lo: Vec2, hi: Vec2) {
+pub(crate) fn clip_to_box(poly: &mut Vec<Vec2>, scratch: &mut Vec<Vec2>, lo: Vec2, hi: Vec2) {
     for (axis, bound, keep_below) in [
         (0, lo.x, false),
         (0, hi.x, true),

@@ -42,6 +42,12 @@ pub enum Error {
         /// What went wrong.
         problem: String,
     },
+    /// A worker thread of the solver failed or panicked (in a host's own `Visibility`, say).
+    #[error("solver worker failed: {problem}")]
+    Worker {
+        /// What happened.
+        problem: String,
+    },
     /// An option value is out of range or inconsistent.
     #[error("invalid option {option}: {problem}")]
     Option {

@@ -49,6 +49,9 @@ struct SolveArgs {
     /// Refuse to place more samples than this.
     #[arg(long)]
     max_samples: Option<usize>,
+    /// Cluster hierarchy error threshold, relative to the mean radiosity (0: the flat solver).
+    #[arg(long)]
+    cluster_threshold: Option<f64>,
     /// Visibility backend: embree or bvh.
     #[arg(long)]
     backend: Option<Backend>,

@@ -64,21 +64,25 @@ fn albedo_099_converges_to_ke_over_one_minus_rho() {
 fn albedo_099_with_few_shots_stops_and_says_how_much_is_left() {
     let mut scene = Scene::load(shipped("box")).unwrap();
     scene.materials[0].kd = Vec3::splat(0.99);
-    let options = Options {
-        max_shots: Some(5_000),
-        rounds: 0,
-        ..Options::default()
-    };
-    let (s, _) = solve(&scene, &options);
-    assert_eq!(s.stop(), StopReason::ShotLimit);
-    let left = s.rounds[0].shooting.unshot_fraction;
-    assert!(
-        left > options.tolerance && left.is_finite(),
-        "unshot fraction {left}"
-    );
-    // What was shot is a lower bound: below the converged answer, above the direct light.
-    let l = s.radiosity[0].x / std::f64::consts::PI;
-    assert!(l > 0.1 * 1.99 && l < 10.0, "{l}");
+    // The flat solver's shots are single samples; the hierarchy's, sweeps of all of them.
+    for (threshold, shots) in [(0.0, 5_000), (Options::default().cluster_threshold, 50)] {
+        let options = Options {
+            max_shots: Some(shots),
+            rounds: 0,
+            cluster_threshold: threshold,
+            ..Options::default()
+        };
+        let (s, _) = solve(&scene, &options);
+        assert_eq!(s.stop(), StopReason::ShotLimit);
+        let left = s.rounds[0].shooting.unshot_fraction;
+        assert!(
+            left > options.tolerance && left.is_finite(),
+            "unshot fraction {left}"
+        );
+        // What was shot is a lower bound: below the converged answer, above the direct light.
+        let l = s.radiosity[0].x / std::f64::consts::PI;
+        assert!(l > 0.1 * 1.99 && l < 10.0, "{l}");
+    }
 }
 
 #[test]

@@ -447,25 +447,28 @@ fn a_dark_scene_is_all_zero_and_says_so() {
 fn a_stopped_solve_returns_its_current_estimate() {
     let scene = Scene::load(shipped("room")).unwrap();
     let vis = Backend::default_backend().build(&scene).unwrap();
-    let mut reports = 0;
-    let s = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |p| {
-        reports += 1;
-        if p.shots >= 64 {
-            Control::Stop
-        } else {
-            Control::Continue
-        }
-    })
-    .unwrap();
-    assert_eq!(s.stop(), StopReason::Stopped);
-    assert_eq!(s.rounds.len(), 1);
-    assert!(
-        s.rounds[0].shooting.shots == 64,
-        "{}",
-        s.rounds[0].shooting.shots
-    );
-    assert!(s.radiosity.iter().any(|b| b.x > 0.0));
-    assert!(reports > 3);
+    // The flat solver counts single shots; the hierarchy, sweeps of every sample at once.
+    for (threshold, limit) in [(0.0, 64), (Options::default().cluster_threshold, 3)] {
+        let mut reports = 0;
+        let options = Options {
+            cluster_threshold: threshold,
+            ..Options::default()
+        };
+        let s = meshlight::solve(&scene, vis.as_ref(), &options, &mut |p| {
+            reports += 1;
+            if p.shots >= limit {
+                Control::Stop
+            } else {
+                Control::Continue
+            }
+        })
+        .unwrap();
+        assert_eq!(s.stop(), StopReason::Stopped);
+        assert_eq!(s.rounds.len(), 1);
+        assert_eq!(s.rounds[0].shooting.shots, limit, "threshold {threshold}");
+        assert!(s.radiosity.iter().any(|b| b.x > 0.0));
+        assert!(reports > 3);
+    }
 }
 
 #[test]

@@ -287,6 +287,7 @@ pub fn solve_setup(args: &crate::SolveArgs) -> anyhow::Result<(Scene, Options)> 
     o.tolerance = args.tolerance.unwrap_or(o.tolerance);
     o.max_shots = args.max_shots.or(o.max_shots);
     o.max_samples = args.max_samples.unwrap_or(o.max_samples);
+    o.cluster_threshold = args.cluster_threshold.unwrap_or(o.cluster_threshold);
     o.backend = args.backend.unwrap_or(o.backend);
     o.threads = args.threads.unwrap_or(o.threads).max(1);
     o.seed = args.seed.unwrap_or(o.seed);
@@ -369,12 +370,13 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
     );
     let _ = writeln!(
         out,
-        "{:>5} {:>8} {:>7} {:>7} {:>8} {:>11} {:>9} {:>17} {:>10} {:>8} {:>8} {:>8} {:>8}",
+        "{:>5} {:>8} {:>7} {:>7} {:>8} {:>10} {:>11} {:>9} {:>17} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8}",
         "round",
         "samples",
         "added",
         "refined",
         "shots",
+        "links",
         "vis queries",
         "shadow q",
         "unshot start→end",
@@ -382,6 +384,7 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
         "place s",
         "areas s",
         "direct s",
+        "links s",
         "shoot s"
     );
     for r in &s.rounds {
@@ -395,12 +398,13 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
         };
         let _ = writeln!(
             out,
-            "{:>5} {:>8} {:>7} {:>7} {:>8} {:>11} {:>9} {:>17} {:>10} {:>8.3} {:>8.3} {:>8.3} {:>8.3}{}",
+            "{:>5} {:>8} {:>7} {:>7} {:>8} {:>10} {:>11} {:>9} {:>17} {:>10} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3}{}",
             r.round,
             r.samples,
             r.added,
             r.refined,
             r.shooting.shots,
+            r.shooting.links,
             r.shooting.queries,
             r.direct_queries,
             format!("{:.2e}→{:.2e}", r.shooting.initial_unshot_fraction, r.shooting.unshot_fraction),
@@ -408,6 +412,7 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
             r.seconds.sampling,
             r.seconds.areas,
             r.seconds.direct,
+            r.seconds.links,
             r.seconds.shooting,
             if r.capped { "  (sample budget reached)" } else { "" }
         );

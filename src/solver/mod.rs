@@ -1,22 +1,28 @@
 //! The meshless solver (method.md §2): initial samples, representative areas, direct light,
-//! progressive radiosity, then adaptive rounds that add samples where light changes and solve
-//! again starting from the previous solution.
+//! shooting, then adaptive rounds that add samples where light changes and solve again
+//! starting from the previous solution (`warm`).
 //!
-//! Warm start: after samples are added and areas recomputed, the light already shot is taken to
-//! be the old samples' shot radiosity (R − ΔB) spread over the new areas: old samples keep
-//! their unshot ΔB; a new sample gets its exact direct light plus indirect light interpolated
-//! from its old neighbours, and its unshot radiosity is the difference between that and the
-//! shot radiosity interpolated at its place. Shooting then only carries the corrections the
-//! new samples bring (mostly sharper direct light), not the whole solution again.
+//! Shooting is hierarchical by default (`cluster`: samples grouped in a cluster tree and linked
+//! where an error bound allows), or flat (`flat`: every sample to every sample) with a cluster
+//! threshold of 0. Both build their form factors from `form_factor`, normalise rows
+//! (`normalise`) and run their heavy work on the same ordered pipeline (`pipeline`).
 
+mod cluster;
+mod flat;
+mod form_factor;
+mod normalise;
 mod options;
-pub mod shooting;
+mod pipeline;
+mod progress;
+mod shooting;
+mod stats;
+mod warm;
 
 use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 
-use crate::area::{self, AreaStats};
+use crate::area;
 use crate::error::{Error, Result};
 use crate::light::{Arrival, DirectLight};
 use crate::parallel::for_chunks;
@@ -26,77 +32,12 @@ use crate::sampling::{
 };
 use crate::scene::Scene;
 use crate::visibility::Visibility;
-pub use options::{Options, AUTO_SAMPLES};
-pub use shooting::{Control, EnergyLedger, ShootStats, StopReason};
-
-/// The phases the solver reports progress in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum Phase {
-    /// Placing initial samples.
-    Sampling,
-    /// Computing representative areas.
-    Areas,
-    /// Integrating direct light at the samples.
-    DirectLight,
-    /// Progressive shooting.
-    Shooting,
-    /// Adding samples where the error is large.
-    Adaptive,
-}
-
-/// A progress report.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Progress {
-    /// Current phase.
-    pub phase: Phase,
-    /// Current round (0 = the first solve).
-    pub round: u32,
-    /// Samples now.
-    pub samples: usize,
-    /// Shots so far in this round's solve.
-    pub shots: u64,
-    /// Unshot power / emitted power (shooting only).
-    pub unshot_fraction: f64,
-    /// The tolerance the shooting aims at.
-    pub tolerance: f64,
-}
-
-/// Seconds spent per phase.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PhaseSeconds {
-    /// Sample placement (initial or adaptive).
-    pub sampling: f64,
-    /// Representative areas.
-    pub areas: f64,
-    /// Direct light.
-    pub direct: f64,
-    /// Shooting.
-    pub shooting: f64,
-}
-
-/// What one round did.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoundStats {
-    /// Round number (0 = the first solve).
-    pub round: u32,
-    /// Samples after this round's additions.
-    pub samples: usize,
-    /// Samples added this round (all of them in round 0).
-    pub added: usize,
-    /// Samples whose error exceeded ζ (rounds ≥ 1).
-    pub refined: usize,
-    /// Whether `max_samples` stopped the addition.
-    pub capped: bool,
-    /// Shadow-ray queries for direct light.
-    pub direct_queries: u64,
-    /// Area cells used.
-    pub areas: AreaStats,
-    /// The shooting.
-    pub shooting: ShootStats,
-    /// Time per phase.
-    pub seconds: PhaseSeconds,
-}
+use cluster::coherence::{Context, TriangleGrid};
+pub use options::{Options, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD};
+pub use progress::{Control, Phase, Progress};
+use shooting::{Settings, State, Tick};
+pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
+use warm::{emission, reflectance};
 
 /// The solved samples.
 #[derive(Clone, Debug)]
@@ -171,10 +112,6 @@ impl Solution {
     }
 }
 
-fn reflectance(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
-    scene.material_of(surface_of(samples.side[k])).kd.as_dvec3()
-}
-
 /// The ε a solve will use, and where it came from.
 pub fn choose_epsilon(scene: &Scene, options: &Options) -> Result<(f32, EpsilonSource)> {
     let (epsilon, source) = match (options.epsilon, scene.solver.epsilon) {
@@ -238,51 +175,23 @@ pub fn solve(
             ),
         });
     }
-    let threads = options.threads.max(1);
     let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
     let maps = SurfaceMap::all(scene);
     let obstruction = Obstruction::new(scene, &maps, lift);
-    let light = DirectLight::new(scene, options.light_samples);
-    let mut report = |phase, round, samples, shots, unshot_fraction| {
-        progress(&Progress {
-            phase,
-            round,
-            samples,
-            shots,
-            unshot_fraction,
-            tolerance: options.tolerance,
-        })
+    let mut solve = Solve {
+        scene,
+        vis,
+        options,
+        light: DirectLight::new(scene, options.light_samples),
+        grid: (options.cluster_threshold > 0.0).then(|| TriangleGrid::new(scene)),
+        lift,
+        epsilon,
+        progress,
     };
 
     // Round 0: Poisson disk on every reflecting side.
     let t = Instant::now();
-    let sides = reflecting_sides(scene);
-    let mut reflecting = vec![false; 2 * scene.surfaces.len()];
-    for &side in &sides {
-        reflecting[side as usize] = true;
-    }
-    let mut samples = Samples::default();
-    // Stopping is honoured from the first shot on: before it there is no estimate to return.
-    let _ = report(Phase::Sampling, 0, 0, 0, 1.0);
-    let mut per_side: Vec<Vec<glam::Vec2>> = vec![Vec::new(); sides.len()];
-    for_chunks(&mut per_side, 1, threads, |i, out| {
-        let side = sides[i];
-        out[0] = poisson::sample_side(
-            &maps[surface_of(side) as usize],
-            side,
-            epsilon,
-            options.seed,
-        );
-        Ok(())
-    })?;
-    for (&side, points) in sides.iter().zip(&per_side) {
-        for &p in points {
-            samples.push(&maps, side, p, epsilon, 0);
-        }
-    }
-    drop(per_side);
-    let sampling_seconds = t.elapsed().as_secs_f64();
-
+    let samples = solve.initial_samples(&maps)?;
     let mut solution = Solution {
         samples,
         radiosity: Vec::new(),
@@ -302,51 +211,138 @@ pub fn solve(
         closed: Vec::new(),
         row_scale: Vec::new(),
     };
-    let mut added = solution.samples.len();
-    let mut refined = 0;
-    let mut capped = false;
-    let mut sampling = sampling_seconds;
+    let mut added = AddedSamples {
+        added: solution.samples.len(),
+        refined: 0,
+        capped: false,
+        seconds: t.elapsed().as_secs_f64(),
+    };
     for round in 0..=options.rounds {
+        let stats = solve.round(&mut solution, round, added)?;
+        solution.rounds.push(stats);
+        if stats.shooting.stop == StopReason::Stopped || round == options.rounds || stats.capped {
+            break;
+        }
+        match solve.add_samples(&mut solution, round + 1)? {
+            Some(more) if more.added > 0 => added = more,
+            _ => break,
+        }
+    }
+    Ok(solution)
+}
+
+/// What one solve holds across its rounds.
+struct Solve<'a> {
+    scene: &'a Scene,
+    vis: &'a dyn Visibility,
+    options: &'a Options,
+    light: DirectLight,
+    /// The scene's triangles for the hierarchy's coherence tests (none for the flat solver).
+    grid: Option<TriangleGrid>,
+    lift: f32,
+    epsilon: f32,
+    progress: &'a mut dyn FnMut(&Progress) -> Control,
+}
+
+/// Samples an adaptive step (or the initial placement) added.
+#[derive(Clone, Copy)]
+struct AddedSamples {
+    added: usize,
+    refined: usize,
+    capped: bool,
+    seconds: f64,
+}
+
+impl Solve<'_> {
+    fn report(&mut self, phase: Phase, round: u32, samples: usize, tick: Option<Tick>) -> Control {
+        let tick = tick.unwrap_or(Tick {
+            phase,
+            shots: 0,
+            unshot_fraction: 1.0,
+            fraction: 0.0,
+        });
+        (self.progress)(&Progress {
+            phase: tick.phase,
+            round,
+            samples,
+            shots: tick.shots,
+            unshot_fraction: tick.unshot_fraction,
+            tolerance: self.options.tolerance,
+            fraction: tick.fraction,
+        })
+    }
+
+    /// Poisson-disk samples on every reflecting side (eq. 3), each side seeded on its own.
+    fn initial_samples(&mut self, maps: &[SurfaceMap]) -> Result<Samples> {
+        // Stopping is honoured from the first shot on: before it there is no estimate to return.
+        let _ = self.report(Phase::Sampling, 0, 0, None);
+        let sides = reflecting_sides(self.scene);
+        let mut per_side: Vec<Vec<glam::Vec2>> = vec![Vec::new(); sides.len()];
+        let (epsilon, seed) = (self.epsilon, self.options.seed);
+        for_chunks(&mut per_side, 1, self.options.threads.max(1), |i, out| {
+            let side = sides[i];
+            out[0] = poisson::sample_side(&maps[surface_of(side) as usize], side, epsilon, seed);
+            Ok(())
+        })?;
+        let mut samples = Samples::default();
+        for (&side, points) in sides.iter().zip(&per_side) {
+            for &p in points {
+                samples.push(maps, side, p, epsilon, 0);
+            }
+        }
+        Ok(samples)
+    }
+
+    /// One round: areas over all samples, direct light and a warm start for the new ones,
+    /// then shooting.
+    fn round(
+        &mut self,
+        solution: &mut Solution,
+        round: u32,
+        added: AddedSamples,
+    ) -> Result<RoundStats> {
+        let (scene, vis, options) = (self.scene, self.vis, self.options);
+        let threads = options.threads.max(1);
         let mut seconds = PhaseSeconds {
-            sampling,
+            sampling: added.seconds,
             ..PhaseSeconds::default()
         };
         let n = solution.samples.len();
-        let first_new = n - added;
+        let first_new = n - added.added;
 
         // Areas over all samples, old and new.
         let t = Instant::now();
-        let _ = report(Phase::Areas, round, n, 0, 1.0);
-        solution.index = SideIndex::new(&solution.samples, &solution.maps, epsilon);
+        let _ = self.report(Phase::Areas, round, n, None);
+        solution.index = SideIndex::new(&solution.samples, &solution.maps, self.epsilon);
         let area_stats = area::compute(
             &mut solution.samples,
             &solution.maps,
             &solution.index,
             &solution.obstruction,
             vis,
-            epsilon,
+            self.epsilon,
             options.alpha,
         )?;
         seconds.areas = t.elapsed().as_secs_f64();
 
         // Direct light at the new samples.
         let t = Instant::now();
-        let _ = report(Phase::DirectLight, round, n, 0, 1.0);
+        let _ = self.report(Phase::DirectLight, round, n, None);
         let s = &solution.samples;
         let points: Vec<(Vec3, Vec3)> = (first_new..n)
             .map(|k| (s.position[k], s.normal[k]))
             .collect();
         let ids: Vec<u32> = (first_new as u32..n as u32).collect();
-        let (arrivals, direct_queries) = light.at(vis, &points, &ids, options.seed, threads)?;
+        let (arrivals, direct_queries) =
+            self.light.at(vis, &points, &ids, options.seed, threads)?;
         seconds.direct = t.elapsed().as_secs_f64();
-
-        warm_start(
+        warm::start(
             scene,
-            &mut solution,
+            solution,
             vis,
             first_new,
             &arrivals,
-            epsilon,
+            self.epsilon,
             options.alpha,
         )?;
         if round == 0 {
@@ -357,26 +353,29 @@ pub fn solve(
             solution.ledger.escaped += solution.ledger.emitted - received;
         }
 
-        // Shoot.
+        // Which new samples see the scene all around (for the row scales).
         let t = Instant::now();
-        let reflectances: Vec<DVec3> = (0..n)
-            .map(|k| reflectance(scene, &solution.samples, k))
-            .collect();
-        let max_shots = options.max_shots.unwrap_or(200 * n as u64);
-        // Which new samples see the scene all around; row scales for new samples.
-        let probes = closed_hemispheres(
+        let sides = reflecting_sides(scene);
+        let mut reflecting = vec![false; 2 * scene.surfaces.len()];
+        for &side in &sides {
+            reflecting[side as usize] = true;
+        }
+        let probes = normalise::closed_hemispheres(
             scene,
             &reflecting,
             &solution.samples,
             first_new,
             vis,
-            options,
-            lift,
+            (options.seed, threads),
+            self.lift,
         )?;
         solution.closed.extend(probes);
+        let hierarchical = self.grid.is_some();
         for k in first_new..n {
+            // The flat solver sums rows in its first round only: later samples take the scale
+            // of their nearest old sample. The hierarchy sums every round's rows.
             let s = &solution.samples;
-            let scale = if round == 0 {
+            let scale = if round == 0 || hierarchical {
                 1.0
             } else {
                 solution
@@ -386,77 +385,124 @@ pub fn solve(
             };
             solution.row_scale.push(scale);
         }
-        let mut state = shooting::State {
+        let probe_seconds = t.elapsed().as_secs_f64();
+
+        // Shoot.
+        let t = Instant::now();
+        let reflectances: Vec<DVec3> = (0..n)
+            .map(|k| reflectance(scene, &solution.samples, k))
+            .collect();
+        let mut state = State {
             samples: &solution.samples,
             maps: &solution.maps,
             reflectance: &reflectances,
+            radiosity: &solution.radiosity,
             irradiance: &mut solution.irradiance,
             unshot: &mut solution.unshot,
             ledger: &mut solution.ledger,
             row_scale: &mut solution.row_scale,
             closed: &solution.closed,
         };
-        let settings = shooting::Settings {
+        let settings = Settings {
             threads,
+            capacity: options.pipeline_capacity.max(1),
             tolerance: options.tolerance,
-            max_shots,
-            lift,
-            cache_bytes: options.cache_bytes,
-            prepass: round == 0,
+            max_shots: options.max_shots.unwrap_or(if hierarchical {
+                u64::MAX
+            } else {
+                200 * n as u64
+            }),
+            lift: self.lift,
+            memory_bytes: options.cache_bytes,
+            normalise: round == 0 || hierarchical,
+            threshold: options.cluster_threshold,
+            seed: options.seed,
         };
-        let shoot_stats = shooting::shoot(&mut state, vis, &settings, &mut |shots, fraction| {
-            report(Phase::Shooting, round, n, shots, fraction)
-        })?;
-        seconds.shooting = t.elapsed().as_secs_f64();
+        let progress = &mut *self.progress;
+        let mut link_seconds = None;
+        let link_start = Instant::now();
+        let mut report = |tick: Tick| {
+            if tick.phase == Phase::Shooting && link_seconds.is_none() {
+                link_seconds = Some(link_start.elapsed().as_secs_f64());
+            }
+            progress(&Progress {
+                phase: tick.phase,
+                round,
+                samples: n,
+                shots: tick.shots,
+                unshot_fraction: tick.unshot_fraction,
+                tolerance: options.tolerance,
+                fraction: tick.fraction,
+            })
+        };
+        let shooting = match &self.grid {
+            Some(grid) => {
+                let cx = Context {
+                    scene,
+                    grid,
+                    samples: state.samples,
+                    obstruction: &solution.obstruction,
+                    lift: self.lift,
+                };
+                cluster::shoot(&mut state, vis, &settings, &cx, &mut report)?
+            }
+            None => flat::shoot(&mut state, vis, &settings, &mut report)?,
+        };
+        let total = t.elapsed().as_secs_f64();
+        let linking = link_seconds.unwrap_or(total);
+        if hierarchical {
+            seconds.links = linking + probe_seconds;
+            seconds.shooting = total - linking;
+        } else {
+            seconds.shooting = total + probe_seconds;
+        }
         for (k, rho) in reflectances.iter().enumerate() {
             solution.radiosity[k] =
                 emission(scene, &solution.samples, k) + *rho * solution.irradiance[k];
         }
-        solution.rounds.push(RoundStats {
+        Ok(RoundStats {
             round,
             samples: n,
-            added,
-            refined,
-            capped,
+            added: added.added,
+            refined: added.refined,
+            capped: added.capped,
             direct_queries,
             areas: area_stats,
-            shooting: shoot_stats,
+            shooting,
             seconds,
-        });
-        if shoot_stats.stop == StopReason::Stopped || round == options.rounds || capped {
-            break;
-        }
+        })
+    }
 
-        // Adaptive: add samples where the error is large.
+    /// Adds samples where the error is large (eqs. 7-8), unless told to stop.
+    fn add_samples(&mut self, solution: &mut Solution, round: u32) -> Result<Option<AddedSamples>> {
         let t = Instant::now();
-        if report(Phase::Adaptive, round + 1, n, 0, 1.0) == Control::Stop {
-            break;
+        if self.report(Phase::Adaptive, round, solution.samples.len(), None) == Control::Stop {
+            return Ok(None);
         }
+        let options = self.options;
         let refinement = adaptive::refine(
             &mut solution.samples,
             &solution.maps,
             &solution.index,
             &solution.obstruction,
-            vis,
+            self.vis,
             &solution.radiosity,
             RefineSettings {
-                epsilon,
+                epsilon: self.epsilon,
                 zeta: options.zeta,
                 alpha: options.alpha,
-                round: (round + 1) as u16,
+                round: round as u16,
                 seed: options.seed,
                 max_samples: options.max_samples,
             },
         )?;
-        sampling = t.elapsed().as_secs_f64();
-        added = refinement.added;
-        refined = refinement.refined;
-        capped = refinement.capped;
-        if added == 0 {
-            break;
-        }
+        Ok(Some(AddedSamples {
+            added: refinement.added,
+            refined: refinement.refined,
+            capped: refinement.capped,
+            seconds: t.elapsed().as_secs_f64(),
+        }))
     }
-    Ok(solution)
 }
 
 /// Irradiance arriving at every sample when the samples `shooters` have radiosity `source`,
@@ -473,78 +519,11 @@ pub fn transfer(
     let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
     let mut irradiance = vec![DVec3::ZERO; samples.len()];
     for &j in shooters {
-        for (i, f) in shooting::form_factors(samples, maps, vis, lift, j as usize)? {
+        for (i, f) in flat::form_factors(samples, maps, vis, lift, j as usize)? {
             irradiance[i as usize] += source * f64::from(f);
         }
     }
     Ok(irradiance)
-}
-
-/// Probe rays per sample for [`closed_hemispheres`].
-const PROBES: u32 = 32;
-
-/// For samples `first..`, whether all of [`PROBES`] cosine-distributed (stratified) rays from
-/// each hit a reflecting surface side (one that has samples): only then do the receiver's form
-/// factors have to cover its whole hemisphere. A probe that escapes, or meets a black side (the
-/// back of a light, say), leaves the row unnormalised. Rays, not segments: a segment ignores
-/// hits near its ends, which lets a probe from a sample beside an edge slip past the
-/// neighbouring face.
-fn closed_hemispheres(
-    scene: &Scene,
-    reflecting: &[bool],
-    samples: &Samples,
-    first: usize,
-    vis: &dyn Visibility,
-    options: &Options,
-    lift: f32,
-) -> Result<Vec<bool>> {
-    use rand::{RngExt, SeedableRng};
-    let (seed, threads, diagonal) = (
-        options.seed,
-        options.threads.max(1),
-        scene.bounds.diagonal(),
-    );
-    let mut out = vec![true; samples.len() - first];
-    for_chunks(&mut out, 128, threads, |start, chunk| {
-        let mut rays = Vec::with_capacity(chunk.len() * PROBES as usize);
-        for k in first + start..first + start + chunk.len() {
-            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(poisson::side_seed(seed, k as u32, 11));
-            let n = samples.normal[k];
-            let (t, b) = n.any_orthonormal_pair();
-            let from = samples.position[k] + lift * n;
-            let rows = PROBES / 4;
-            for i in 0..PROBES {
-                // Stratified over (radius², angle): cosine-weighted directions.
-                let u = ((i / 4) as f32 + rng.random::<f32>()) / rows as f32;
-                let v = ((i % 4) as f32 + rng.random::<f32>()) / 4.0;
-                let (r, phi) = (u.sqrt(), v * std::f32::consts::TAU);
-                let d = t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u).max(0.0).sqrt();
-                rays.push(crate::visibility::Ray {
-                    origin: from,
-                    dir: d,
-                    t_min: 0.0,
-                    t_max: 2.0 * diagonal,
-                });
-            }
-        }
-        let mut hits = vec![None; rays.len()];
-        vis.intersect(&rays, &mut hits)?;
-        for ((o, hits), rays) in chunk
-            .iter_mut()
-            .zip(hits.chunks(PROBES as usize))
-            .zip(rays.chunks(PROBES as usize))
-        {
-            *o = hits.iter().zip(rays).all(|(hit, ray)| {
-                hit.is_some_and(|h| {
-                    let t = &scene.triangles[h.triangle as usize];
-                    let side = crate::sampling::side_of(t.surface, ray.dir.dot(t.normal) > 0.0);
-                    reflecting[side as usize]
-                })
-            });
-        }
-        Ok(())
-    })?;
-    Ok(out)
 }
 
 fn check(options: &Options) -> Result<()> {
@@ -570,72 +549,14 @@ fn check(options: &Options) -> Result<()> {
     if options.light_samples == 0 {
         return fail("light-samples", "must be at least 1".into());
     }
-    Ok(())
-}
-
-/// Emitted radiosity π·Ke of sample k (emitters emit from their front only).
-fn emission(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
-    let side = samples.side[k];
-    if crate::sampling::is_back(side) {
-        return DVec3::ZERO;
+    if !(options.cluster_threshold.is_finite() && options.cluster_threshold >= 0.0) {
+        return fail(
+            "cluster-threshold",
+            format!(
+                "{} must be a finite number ≥ 0 (0: the flat solver)",
+                options.cluster_threshold
+            ),
+        );
     }
-    std::f64::consts::PI * scene.material_of(surface_of(side)).ke.as_dvec3()
-}
-
-/// Extends the solution's per-sample arrays to the new samples and sets their unshot
-/// radiosity for a (warm) start: see the module doc.
-fn warm_start(
-    scene: &Scene,
-    solution: &mut Solution,
-    vis: &dyn Visibility,
-    first_new: usize,
-    arrivals: &[Arrival],
-    epsilon: f32,
-    alpha: f32,
-) -> Result<()> {
-    let n = solution.samples.len();
-    let samples = &solution.samples;
-    let mut near = Vec::new();
-    let r = 2.0 * epsilon;
-    for (a, k) in arrivals.iter().zip(first_new..n) {
-        let rho = reflectance(scene, samples, k);
-        // Interpolated from the old samples: indirect irradiance, and radiosity already shot.
-        let (mut wsum, mut indirect, mut shot) = (0.0, DVec3::ZERO, DVec3::ZERO);
-        if first_new > 0 {
-            solution
-                .index
-                .within(samples, samples.side[k], samples.uv[k], r, &mut near);
-            near.retain(|&(j, _)| (j as usize) < first_new);
-            near.sort_unstable_by_key(|&(j, _)| j);
-            let side = samples.side[k];
-            solution.obstruction.retain_visible(
-                vis,
-                &solution.maps,
-                samples,
-                side,
-                samples.position[k],
-                &mut near,
-            )?;
-            for &(j, d2) in &near {
-                let j = j as usize;
-                let w = f64::from((-alpha * d2.sqrt() / r).exp());
-                wsum += w;
-                indirect += w * (solution.irradiance[j] - solution.direct[j].irradiance);
-                shot += w * (rho * solution.irradiance[j] - solution.unshot[j]);
-            }
-        }
-        if wsum > 0.0 {
-            indirect /= wsum;
-            shot /= wsum;
-        }
-        let h = a.irradiance + indirect;
-        solution.direct.push(*a);
-        solution.irradiance.push(h);
-        solution.unshot.push(rho * h - shot);
-        solution
-            .radiosity
-            .push(emission(scene, samples, k) + rho * h);
-    }
-    debug_assert_eq!(solution.irradiance.len(), n);
     Ok(())
 }

@@ -32,12 +32,21 @@ pub struct Options {
     /// The solver refuses an ε that would place more samples than this, and adaptive rounds
     /// stop adding samples at it.
     pub max_samples: usize,
-    /// Memory the shooting may use to keep each shooter's visible receivers and form factors
-    /// (bytes; 0 disables): re-shooting a kept sample costs no visibility query. Results do not
-    /// depend on it, only time.
+    /// The cluster hierarchy's error threshold τ, relative to the mean radiosity: a link between
+    /// two clusters is accepted when the radiosity error it can make at its receiver is below
+    /// τ × the mean radiosity; otherwise the larger cluster is split, down to single samples.
+    /// Useful 0.01–1: larger is faster and coarser. 0 selects the flat solver (every sample
+    /// linked to every sample, O(N²)), the reference the hierarchy is measured against.
+    pub cluster_threshold: f64,
+    /// Memory the flat solver may use to keep each shooter's visible receivers and form
+    /// factors (bytes; 0 disables): re-shooting a kept sample costs no visibility query.
+    /// Results do not depend on it, only time.
     pub cache_bytes: usize,
     /// Worker threads (≥ 1). Results do not depend on it.
     pub threads: usize,
+    /// Jobs in flight in the solver's pipeline at most (≥ 1): bounds the memory the pipeline
+    /// holds. Results do not depend on it.
+    pub pipeline_capacity: usize,
     /// Seed of every random choice (sample placement, shadow rays).
     pub seed: u64,
     /// Visibility backend.
@@ -46,6 +55,9 @@ pub struct Options {
 
 /// Initial sample count the automatic ε aims at.
 pub const AUTO_SAMPLES: f64 = 4000.0;
+
+/// The default [`Options::cluster_threshold`].
+pub const DEFAULT_CLUSTER_THRESHOLD: f64 = 0.05;
 
 impl Default for Options {
     fn default() -> Self {
@@ -58,10 +70,12 @@ impl Default for Options {
             tolerance: 1e-3,
             max_shots: None,
             max_samples: 2_000_000,
+            cluster_threshold: DEFAULT_CLUSTER_THRESHOLD,
             cache_bytes: 2 << 30,
             threads: std::thread::available_parallelism()
                 .map_or(2, |n| n.get())
                 .min(8),
+            pipeline_capacity: 16,
             seed: 1,
             backend: Backend::default_backend(),
         }

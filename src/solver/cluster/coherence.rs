@@ -1,0 +1,217 @@
+//! Which nodes may stand for their members in a link. A link's visibility comes from a few
+//! rays between members; if a wall stood between two members of one node (a floor running
+//! under a partition into the next room, two parallel walls on either side of one), those rays
+//! could all land on one side of it and the node's light would be pushed to members the
+//! shooter cannot see: light through walls. So a node is coherent only when no triangle meeting
+//! the box of its members' sample points has members on both sides of its plane. A surface
+//! whose plane bounds the members (a floor under a wall node, the other facets of a convex
+//! sculpture, a picture hanging in front of a wall) cannot stand between them; a partition on a
+//! floor node, a pedestal, a frame bar across a wall node can.
+//!
+//! Incoherent nodes are only ever split, never linked; single samples are always coherent. The
+//! tree splits a side's incoherent node along the plane of the triangle standing among its
+//! members (as a BSP would), so that an occluder costs a few incoherent nodes, not every node
+//! its outline crosses.
+//! Occluders that merely hover between a node and a shooter are what the link's rays are for.
+
+use std::ops::Range;
+
+use glam::{IVec3, Vec3};
+
+use crate::sampling::{Obstruction, Samples};
+use crate::scene::Scene;
+
+/// The scene's triangles in a uniform grid of their bounding boxes (compressed rows).
+pub(crate) struct TriangleGrid {
+    min: Vec3,
+    cell: f32,
+    dims: IVec3,
+    starts: Vec<u32>,
+    entries: Vec<u32>,
+}
+
+impl TriangleGrid {
+    /// Grids the scene's triangles: about 64 cells along the longest extent.
+    pub fn new(scene: &Scene) -> TriangleGrid {
+        let (min, max) = (scene.bounds.min, scene.bounds.max);
+        let cell = ((max - min).max_element() / 64.0).max(1e-30);
+        let dims = (((max - min) / cell).floor().as_ivec3() + 1).max(IVec3::ONE);
+        let mut grid = TriangleGrid {
+            min,
+            cell,
+            dims,
+            starts: Vec::new(),
+            entries: Vec::new(),
+        };
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for (i, t) in scene.triangles.iter().enumerate() {
+            let (lo, hi) = bounds(&t.vertices);
+            grid.for_cells(lo, hi, |c| pairs.push((c, i as u32)));
+        }
+        pairs.sort_unstable();
+        let cells = (dims.x * dims.y * dims.z) as usize;
+        grid.starts = vec![0; cells + 1];
+        for &(c, _) in &pairs {
+            grid.starts[c as usize + 1] += 1;
+        }
+        for c in 0..cells {
+            grid.starts[c + 1] += grid.starts[c];
+        }
+        grid.entries = pairs.into_iter().map(|(_, t)| t).collect();
+        grid
+    }
+
+    fn key(&self, p: Vec3) -> IVec3 {
+        ((p - self.min) / self.cell)
+            .floor()
+            .as_ivec3()
+            .clamp(IVec3::ZERO, self.dims - 1)
+    }
+
+    fn for_cells(&self, lo: Vec3, hi: Vec3, mut f: impl FnMut(u32)) {
+        let (a, b) = (self.key(lo), self.key(hi));
+        for z in a.z..=b.z {
+            for y in a.y..=b.y {
+                for x in a.x..=b.x {
+                    f(((z * self.dims.y + y) * self.dims.x + x) as u32);
+                }
+            }
+        }
+    }
+
+    /// Whether `test` holds for some triangle whose grid cells meet the box [lo, hi] (a
+    /// triangle may be tested more than once).
+    fn any(&self, lo: Vec3, hi: Vec3, mut test: impl FnMut(u32) -> bool) -> bool {
+        let (a, b) = (self.key(lo), self.key(hi));
+        for z in a.z..=b.z {
+            for y in a.y..=b.y {
+                let row = ((z * self.dims.y + y) * self.dims.x) as usize;
+                let range: Range<usize> = self.starts[row + a.x as usize] as usize
+                    ..self.starts[row + b.x as usize + 1] as usize;
+                if self.entries[range].iter().any(|&t| test(t)) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// What the coherence tests look at.
+pub(crate) struct Context<'a> {
+    pub scene: &'a Scene,
+    pub grid: &'a TriangleGrid,
+    pub samples: &'a Samples,
+    pub obstruction: &'a Obstruction,
+    /// How far sample points are lifted off their surfaces: the tolerance of the tests.
+    pub lift: f32,
+}
+
+/// A plane that splits a set of samples: a triangle's, with members on both sides.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Splitter {
+    pub normal: Vec3,
+    pub offset: f32,
+}
+
+impl Splitter {
+    /// Whether a point lies in front of the plane.
+    pub fn in_front(&self, p: Vec3) -> bool {
+        self.normal.dot(p) > self.offset
+    }
+}
+
+/// The first triangle (in grid order) that stands among `members` (whose sample points have
+/// bounds `lo`, `hi`): it meets their box and its plane has members strictly on both sides.
+/// `None`: the members form a coherent node. `side` is the side all members lie on, if one:
+/// when nothing stands on that side anywhere, no triangle is looked at.
+pub(crate) fn splitter(
+    cx: &Context,
+    side: Option<u32>,
+    members: &[u32],
+    lo: Vec3,
+    hi: Vec3,
+) -> Option<Splitter> {
+    if side.is_some_and(|side| !cx.obstruction.is_obstructed(side)) || members.len() < 2 {
+        return None;
+    }
+    let pad = Vec3::splat(cx.lift);
+    let (blo, bhi) = (lo - pad, hi + pad);
+    let mut found = None;
+    cx.grid.any(blo, bhi, |t| {
+        let tri = &cx.scene.triangles[t as usize];
+        if splits(tri.normal, tri.vertices[0], lo, hi, members, cx)
+            && meets_box(&tri.vertices, blo, bhi)
+        {
+            found = Some(Splitter {
+                normal: tri.normal,
+                offset: tri.normal.dot(tri.vertices[0]),
+            });
+            return true;
+        }
+        false
+    });
+    found
+}
+
+/// Whether the plane through `point` with unit `normal` has members strictly (beyond the lift)
+/// on both sides: first from the members' box, then member by member.
+fn splits(normal: Vec3, point: Vec3, lo: Vec3, hi: Vec3, members: &[u32], cx: &Context) -> bool {
+    let c = normal.dot(point);
+    let centre = normal.dot(0.5 * (lo + hi)) - c;
+    let half = normal.abs().dot(0.5 * (hi - lo));
+    if centre - half >= -cx.lift || centre + half <= cx.lift {
+        return false;
+    }
+    let (mut below, mut above) = (false, false);
+    for &k in members {
+        let h = normal.dot(cx.samples.position[k as usize]) - c;
+        below |= h < -cx.lift;
+        above |= h > cx.lift;
+        if below && above {
+            return true;
+        }
+    }
+    false
+}
+
+/// Whether a triangle meets an axis-aligned box (clipped to its six planes, something is left).
+fn meets_box(t: &[Vec3; 3], lo: Vec3, hi: Vec3) -> bool {
+    let (tlo, thi) = bounds(t);
+    if tlo.cmpgt(hi).any() || thi.cmplt(lo).any() {
+        return false;
+    }
+    let mut poly: Vec<Vec3> = t.to_vec();
+    let mut scratch = Vec::with_capacity(9);
+    for axis in 0..3 {
+        let mut n = Vec3::ZERO;
+        n[axis] = 1.0;
+        clip_half_space(&mut poly, &mut scratch, n, lo[axis]);
+        clip_half_space(&mut poly, &mut scratch, -n, -hi[axis]);
+        if poly.is_empty() {
+            return false;
+        }
+    }
+    true
+}
+
+/// Clips a convex polygon to the half-space n·x ≥ c (closed, so a polygon touching the plane
+/// keeps its touching points).
+fn clip_half_space(poly: &mut Vec<Vec3>, scratch: &mut Vec<Vec3>, n: Vec3, c: f32) {
+    scratch.clear();
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (da, db) = (n.dot(a) - c, n.dot(b) - c);
+        if da >= 0.0 {
+            scratch.push(a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            scratch.push(a + (b - a) * (da / (da - db)));
+        }
+    }
+    std::mem::swap(poly, scratch);
+}
+
+fn bounds(v: &[Vec3; 3]) -> (Vec3, Vec3) {
+    (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]))
+}

@@ -1,0 +1,541 @@
+//! Links between clusters, refined by an error bound as in hierarchical radiosity with
+//! clustering (Hanrahan, Salzman and Aupperle 1991; Smits, Arvo and Greenberg 1994).
+//!
+//! Light goes both ways along a pair of nodes and visibility is symmetric, so pairs are refined
+//! unordered: starting from two receiver groups' roots, a pair {A, B} is
+//! - dropped when no member of one faces any member of the other (the planes, or the normal
+//!   cones and the pair's angular size, say so), or when it is a planar node with itself;
+//! - a pair of leaf links when both are single samples: the flat solver's form factors and one
+//!   ray;
+//! - a pair of cluster links (A → B and B → A) when both nodes are coherent, well separated
+//!   (d > 2(r_A + r_B), and beyond the near field of either node's largest sample), and the
+//!   bound on the radiosity error either link can make at its receiver is below the tolerance:
+//!   ρ_max(R) · P_S · (c_S⁺c_R⁺/(d − r)² − c_S⁻c_R⁻/(d + r)²) / π, with P_S the power the
+//!   shooter stands for, r = r_A + r_B, and c± the largest and smallest cosines the geometry
+//!   allows (the least taken as 0 where some members face away). Its visibility comes from
+//!   probes: member pairs, every pair when there are few, else stratified; a ray for each
+//!   pair that faces. All visible (and each node wholly in front of the other): linked. None:
+//!   dropped. Some: refined; where every pair was probed, each visible pair becomes a leaf
+//!   link. Visibility never makes a link coarser, and a partly visible link is averaged only
+//!   where everything it could carry is negligible;
+//! - otherwise refined: the larger node (the one holding the other, if so) is split.
+//!
+//! Where some members face away (a facet whose plane cuts through a wall node), a fully
+//! visible link is kept with its formula scaled by Σ (exact form factor) / Σ (formula) over
+//! its probes, which counts the pairs facing away as nothing.
+//!
+//! Pairs are taken from a stack in waves; each wave's rays go to the backend in one batch. The
+//! order is fixed, so the links do not depend on the thread count.
+
+use glam::Vec3;
+
+use super::tree::{angle, Ref, Tree, View, MULTI};
+use crate::error::Result;
+use crate::sampling::{Samples, SurfaceMap};
+use crate::solver::form_factor::{segment, Shooter, NEAR};
+use crate::visibility::{Segment, Visibility};
+
+/// A link between two samples: receiver r gets F · ΔB_s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LeafLink {
+    pub r: u32,
+    pub s: u32,
+    pub f: f32,
+}
+
+/// A link between clusters (or a cluster and a sample): `sweep`'s formula from s to r, times
+/// `factor` (1, or the probes' correction).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ClusterLink {
+    pub r: Ref,
+    pub s: Ref,
+    pub factor: f32,
+}
+
+/// The links into one receiver group (or part of them).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Links {
+    pub leaf: Vec<LeafLink>,
+    pub cluster: Vec<ClusterLink>,
+    /// Visibility queries made to find them.
+    pub queries: u64,
+}
+
+impl Links {
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.leaf.capacity() * std::mem::size_of::<LeafLink>()
+            + self.cluster.capacity() * std::mem::size_of::<ClusterLink>()
+    }
+
+    /// Appends another set of links.
+    pub fn append(&mut self, other: &mut Links) {
+        self.leaf.append(&mut other.leaf);
+        self.cluster.append(&mut other.cluster);
+        self.queries += other.queries;
+    }
+}
+
+/// Pairs taken from the stack per batch of rays.
+const WAVE: usize = 256;
+/// Probes per cluster link, unless its member pairs are fewer than [`EXHAUSTIVE`].
+const PROBES: usize = 8;
+/// Links with at most this many member pairs probe every pair.
+const EXHAUSTIVE: usize = 16;
+/// A partly visible link is refined unless everything it could carry, seen wholly visible, is
+/// below this fraction of the tolerance: then it carries what its visible probes say. Such
+/// links never cross a wall (nodes never straddle an occluder: `coherence`), so this only
+/// blurs a faint penumbra.
+const NEGLIGIBLE: f64 = 0.25;
+/// The least cosine at either end of a link whose formula is scaled by its probes (see
+/// `Linker::conditioned`).
+const MIN_COS: f32 = 0.2;
+
+/// What link building reads.
+pub(crate) struct Linker<'a> {
+    pub tree: &'a Tree,
+    pub samples: &'a Samples,
+    pub maps: &'a [SurfaceMap],
+    pub vis: &'a dyn Visibility,
+    pub lift: f32,
+    /// The largest radiosity error a cluster link may make (threshold × reference radiosity).
+    pub tolerance: f64,
+    pub seed: u64,
+}
+
+/// A pair waiting for its rays: probes `first..first + probes` of the wave.
+struct Pending {
+    a: Ref,
+    b: Ref,
+    first: usize,
+    probes: usize,
+    kind: Kind,
+}
+
+enum Kind {
+    /// Two samples, with the form factors a → b and b → a (if they face).
+    Leaf(Option<f32>, Option<f32>),
+    Cluster {
+        /// Every member pair is among the probes.
+        exhaustive: bool,
+        /// Whether each node lies wholly in front of the other.
+        one_sided: bool,
+        /// Whether everything the links could carry is below [`NEGLIGIBLE`] × the tolerance.
+        negligible: bool,
+    },
+}
+
+/// A member pair (i of a, k of b) a link looks at: its form factors each way (the shooting
+/// member's area included), what the links' formula gives the same pair each way, and its
+/// ray in the wave's batch (none where the two do not face each other: no light passes
+/// whatever stands between them).
+#[derive(Clone, Copy)]
+struct Probe {
+    i: u32,
+    k: u32,
+    exact: [f64; 2],
+    formula: [f64; 2],
+    ray: Option<u32>,
+}
+
+/// Links found: into the first group of the pair, and into the second.
+pub(crate) type Found = (Links, Links);
+
+impl Linker<'_> {
+    /// Every link between the subtrees of `a` and `b` (two receiver groups, or one group with
+    /// itself), in both directions.
+    pub fn links_between(&self, a: Ref, b: Ref) -> Result<Found> {
+        let mut found: Found = Default::default();
+        let mut stack = vec![(a, b)];
+        let mut pending: Vec<Pending> = Vec::new();
+        let mut segments: Vec<Segment> = Vec::new();
+        let mut probes: Vec<Probe> = Vec::new();
+        let mut blocked: Vec<bool> = Vec::new();
+        while !stack.is_empty() {
+            pending.clear();
+            segments.clear();
+            probes.clear();
+            let mut taken = 0;
+            while taken < WAVE {
+                let Some((x, y)) = stack.pop() else { break };
+                taken += 1;
+                self.classify(x, y, &mut stack, &mut pending, &mut segments, &mut probes);
+            }
+            if segments.is_empty() {
+                continue;
+            }
+            blocked.clear();
+            blocked.resize(segments.len(), false);
+            self.vis.occluded(&segments, &mut blocked)?;
+            found.0.queries += segments.len() as u64;
+            for p in &pending {
+                let probes = &probes[p.first..p.first + p.probes];
+                self.resolve(p, probes, &blocked, &mut found, &mut stack, a == b);
+            }
+        }
+        for links in [&mut found.0, &mut found.1] {
+            links.leaf.shrink_to_fit();
+            links.cluster.shrink_to_fit();
+        }
+        Ok(found)
+    }
+
+    /// What a pair's rays say: links, nothing, or a split.
+    fn resolve(
+        &self,
+        p: &Pending,
+        probes: &[Probe],
+        blocked: &[bool],
+        found: &mut Found,
+        stack: &mut Vec<(Ref, Ref)>,
+        same_group: bool,
+    ) {
+        let seen = |q: &Probe| q.ray.is_some_and(|ray| !blocked[ray as usize]);
+        // Links into b go to the second group, into a to the first (one group: both there).
+        let push_leaf = |found: &mut Found, into_b: bool, link: LeafLink| {
+            if into_b && !same_group {
+                found.1.leaf.push(link)
+            } else {
+                found.0.leaf.push(link)
+            }
+        };
+        let leaf_links = |found: &mut Found, q: &Probe| {
+            let (i, k) = (q.i as usize, q.k as usize);
+            if let Some(f) = Shooter::of(self.samples, self.maps, i).factor_to(self.samples, k) {
+                push_leaf(found, true, LeafLink { r: q.k, s: q.i, f });
+            }
+            if let Some(f) = Shooter::of(self.samples, self.maps, k).factor_to(self.samples, i) {
+                push_leaf(found, false, LeafLink { r: q.i, s: q.k, f });
+            }
+        };
+        match p.kind {
+            Kind::Leaf(ab, ba) => {
+                if seen(&probes[0]) {
+                    let (i, k) = (p.a.index() as u32, p.b.index() as u32);
+                    if let Some(f) = ab {
+                        push_leaf(found, true, LeafLink { r: k, s: i, f });
+                    }
+                    if let Some(f) = ba {
+                        push_leaf(found, false, LeafLink { r: i, s: k, f });
+                    }
+                }
+            }
+            Kind::Cluster {
+                exhaustive,
+                one_sided,
+                negligible,
+            } => {
+                let rays = probes.iter().filter(|q| q.ray.is_some()).count();
+                let visible = probes.iter().filter(|q| seen(q)).count();
+                let all = rays > 0 && visible == rays;
+                if (exhaustive && rays == 0) || (rays > 0 && visible == 0) {
+                    // Nothing faces, or every facing pair is blocked.
+                } else if all && one_sided {
+                    self.cluster_links(p, [1.0, 1.0], found, same_group);
+                } else if exhaustive {
+                    // Every member pair is known: the visible ones, sample to sample.
+                    for q in probes.iter().filter(|q| seen(q)) {
+                        leaf_links(found, q);
+                    }
+                } else if (all || negligible) && self.conditioned(p.a, p.b) {
+                    // The formula, scaled by Σ visible exact / Σ formula over the probes.
+                    let factor = |d: usize| {
+                        let formula: f64 = probes.iter().map(|q| q.formula[d]).sum();
+                        let exact: f64 =
+                            probes.iter().filter(|q| seen(q)).map(|q| q.exact[d]).sum();
+                        if formula > 0.0 {
+                            (exact / formula) as f32
+                        } else {
+                            0.0
+                        }
+                    };
+                    self.cluster_links(p, [factor(0), factor(1)], found, same_group);
+                } else if !(negligible && rays == 0) {
+                    self.split(p.a, p.b, stack);
+                }
+            }
+        }
+    }
+
+    /// The links a → b and b → a, with their factors.
+    fn cluster_links(&self, p: &Pending, factor: [f32; 2], found: &mut Found, same_group: bool) {
+        let into_b = ClusterLink {
+            r: p.b,
+            s: p.a,
+            factor: factor[0],
+        };
+        let into_a = ClusterLink {
+            r: p.a,
+            s: p.b,
+            factor: factor[1],
+        };
+        if into_b.factor > 0.0 {
+            if same_group {
+                found.0.cluster.push(into_b);
+            } else {
+                found.1.cluster.push(into_b);
+            }
+        }
+        if into_a.factor > 0.0 {
+            found.0.cluster.push(into_a);
+        }
+    }
+
+    /// Decides what to do with the pair {a, b}: see the module doc.
+    fn classify(
+        &self,
+        a: Ref,
+        b: Ref,
+        stack: &mut Vec<(Ref, Ref)>,
+        pending: &mut Vec<Pending>,
+        segments: &mut Vec<Segment>,
+        probes: &mut Vec<Probe>,
+    ) {
+        let tree = self.tree;
+        if a == b {
+            if a.is_leaf() || tree.nodes[a.index()].side != MULTI {
+                // A sample, or samples of one plane: nothing passes between them.
+                return;
+            }
+            let [x, y] = tree.nodes[a.index()].children;
+            stack.extend([(y, y), (x, y), (x, x)]);
+            return;
+        }
+        let (av, bv) = (tree.view(self.samples, a), tree.view(self.samples, b));
+        if !a.is_leaf() && holds(&av, &bv) {
+            push_children(tree, a, |c| stack.push((c, b)));
+            return;
+        }
+        if !b.is_leaf() && holds(&bv, &av) {
+            push_children(tree, b, |c| stack.push((a, c)));
+            return;
+        }
+        if a.is_leaf() && b.is_leaf() {
+            let (i, k) = (a.index(), b.index());
+            let ab = Shooter::of(self.samples, self.maps, i).factor_to(self.samples, k);
+            let ba = Shooter::of(self.samples, self.maps, k).factor_to(self.samples, i);
+            if ab.is_some() || ba.is_some() {
+                pending.push(Pending {
+                    a,
+                    b,
+                    first: probes.len(),
+                    probes: 1,
+                    kind: Kind::Leaf(ab, ba),
+                });
+                probes.push(Probe {
+                    i: i as u32,
+                    k: k as u32,
+                    exact: [0.0; 2],
+                    formula: [0.0; 2],
+                    ray: Some(segments.len() as u32),
+                });
+                segments.push(segment(self.samples, self.lift, i, k));
+            }
+            return;
+        }
+        let d = bv.centroid - av.centroid;
+        let dist = d.length();
+        let reach = av.radius + bv.radius;
+        let (Some(cos_a), Some(cos_b)) = (
+            cosines(&av, &bv, d, dist, reach, self.lift),
+            cosines(&bv, &av, -d, dist, reach, self.lift),
+        ) else {
+            // No member of one faces any member of the other.
+            return;
+        };
+        let admissible = dist > 2.0 * reach
+            && av.coherent
+            && bv.coherent
+            && dist - reach >= NEAR * av.max_area.max(bv.max_area).sqrt();
+        if admissible {
+            // Where some members may face away, only the bound from above holds (their pairs
+            // exchange nothing; the link would give them light): the whole transfer must then
+            // be below the tolerance.
+            let one_sided = cos_a.2 && cos_b.2;
+            let (near, far) = (f64::from(dist - reach), f64::from(dist + reach));
+            let upper = f64::from(cos_a.1 * cos_b.1) / (near * near);
+            let lower = if one_sided {
+                f64::from(cos_a.0 * cos_b.0) / (far * far)
+            } else {
+                0.0
+            };
+            let weight = (f64::from(bv.rho) * av.power).max(f64::from(av.rho) * bv.power)
+                / std::f64::consts::PI;
+            if weight * (upper - lower) < self.tolerance {
+                let first = probes.len();
+                let exhaustive = self.probe(&av, &bv, d, segments, probes, (a, b));
+                pending.push(Pending {
+                    a,
+                    b,
+                    first,
+                    probes: probes.len() - first,
+                    kind: Kind::Cluster {
+                        exhaustive,
+                        one_sided,
+                        negligible: weight * upper < NEGLIGIBLE * self.tolerance,
+                    },
+                });
+                return;
+            }
+        }
+        self.split(a, b, stack);
+    }
+
+    /// Whether the links' formula is far from grazing at both ends (the centroids' direction
+    /// makes a cosine of at least [`MIN_COS`] with either node's axis), so that scaling it by
+    /// its probes is well conditioned.
+    fn conditioned(&self, a: Ref, b: Ref) -> bool {
+        let (av, bv) = (
+            self.tree.view(self.samples, a),
+            self.tree.view(self.samples, b),
+        );
+        let omega = (bv.centroid - av.centroid).normalize_or_zero();
+        av.axis.dot(omega) >= MIN_COS && -bv.axis.dot(omega) >= MIN_COS
+    }
+
+    /// Refines a pair by splitting the larger node (a sample cannot be split).
+    fn split(&self, a: Ref, b: Ref, stack: &mut Vec<(Ref, Ref)>) {
+        let tree = self.tree;
+        let split_a = if a.is_leaf() {
+            false
+        } else if b.is_leaf() {
+            true
+        } else {
+            tree.nodes[a.index()].radius >= tree.nodes[b.index()].radius
+        };
+        if split_a {
+            push_children(tree, a, |c| stack.push((c, b)));
+        } else {
+            push_children(tree, b, |c| stack.push((a, c)));
+        }
+    }
+
+    /// Queues the probes (and the rays of those that face) that decide a pair's visibility;
+    /// returns whether they cover every member pair. `d` runs from a's centroid to b's.
+    fn probe(
+        &self,
+        av: &View,
+        bv: &View,
+        d: Vec3,
+        segments: &mut Vec<Segment>,
+        probes: &mut Vec<Probe>,
+        (a, b): (Ref, Ref),
+    ) -> bool {
+        let order = &self.tree.order;
+        let member = |v: &View, x: usize| order[v.first as usize + x] as usize;
+        let (na, nb) = (av.count as usize, bv.count as usize);
+        let samples = self.samples;
+        let omega = d.normalize().as_dvec3();
+        let length2 = f64::from(d.length_squared());
+        let pi = std::f64::consts::PI;
+        let mut push = |i: usize, k: usize| {
+            let (ni, nk) = (samples.normal[i].as_dvec3(), samples.normal[k].as_dvec3());
+            let v = (samples.centroid[k] - samples.centroid[i]).as_dvec3();
+            let l2 = v.length_squared();
+            let kernel = if l2 > 0.0 {
+                ni.dot(v).max(0.0) * (-nk.dot(v)).max(0.0) / (pi * l2 * l2)
+            } else {
+                0.0
+            };
+            let formula = ni.dot(omega).max(0.0) * (-nk.dot(omega)).max(0.0) / (pi * length2);
+            let ray = (kernel > 0.0).then(|| {
+                segments.push(segment(samples, self.lift, i, k));
+                segments.len() as u32 - 1
+            });
+            let (si, sk) = (samples.area[i], samples.area[k]);
+            probes.push(Probe {
+                i: i as u32,
+                k: k as u32,
+                exact: [kernel * si, kernel * sk],
+                formula: [formula * si, formula * sk],
+                ray,
+            });
+        };
+        if na * nb <= EXHAUSTIVE {
+            for x in 0..na {
+                for y in 0..nb {
+                    push(member(av, x), member(bv, y));
+                }
+            }
+            return true;
+        }
+        // Stratified: the members' ranges (spatially coherent in tree order) cut in PROBES
+        // strata each, b's strata visited in a shuffled order.
+        let pair = mix(u64::from(a.raw()) << 32 | u64::from(b.raw()));
+        for x in 0..PROBES {
+            let h = mix(self.seed ^ pair ^ x as u64);
+            let to_unit = |bits: u64| bits as f64 / (1u64 << 24) as f64;
+            let (u, w) = (to_unit(h >> 40), to_unit(h & 0xff_ffff));
+            let y = (x * 5 + 3) % PROBES;
+            let i = (((x as f64 + u) / PROBES as f64) * na as f64) as usize;
+            let k = (((y as f64 + w) / PROBES as f64) * nb as f64) as usize;
+            push(member(av, i.min(na - 1)), member(bv, k.min(nb - 1)));
+        }
+        false
+    }
+}
+
+/// Bounds on the cosine between the normal of a member of `v` and the direction to a member
+/// of `other`, whose centroid lies at `to` (length `dist`; `reach` the sum of the radii): the
+/// least (≥ 0: pairs facing away exchange nothing), the greatest, and whether `v` is one-sided
+/// toward `other` (no sample point of `other` lies behind a member of `v`). `None` when no
+/// member of `other` can lie in front of any member of `v`. A planar node (one side, or a
+/// sample) bounds the cosine by the other node's height above its plane; a node over several
+/// sides by its normal cone and the pair's angular size.
+fn cosines(
+    v: &View,
+    other: &View,
+    to: Vec3,
+    dist: f32,
+    reach: f32,
+    lift: f32,
+) -> Option<(f32, f32, bool)> {
+    if v.side != MULTI {
+        // The lowest and highest sample points of `other` above the plane, from its bounds:
+        // nothing passes to a node that lies wholly behind the plane or in it.
+        let centre = v.axis.dot(0.5 * (other.lo + other.hi) - v.centroid);
+        let extent = v.axis.abs().dot(0.5 * (other.hi - other.lo));
+        if centre + extent <= lift {
+            return None;
+        }
+        let one_sided = centre - extent >= -lift;
+        let h = v.axis.dot(to);
+        if dist <= reach {
+            return Some((0.0, 1.0, one_sided));
+        }
+        let least = ((h - other.radius) / (dist + reach)).max(0.0);
+        let most = ((h + other.radius) / (dist - reach)).min(1.0);
+        return Some((least, most, one_sided));
+    }
+    if dist <= reach || v.spread >= std::f32::consts::PI {
+        return Some((0.0, 1.0, false));
+    }
+    let beta = (reach / dist).asin();
+    let a = angle(v.axis, to / dist);
+    if a - v.spread - beta >= std::f32::consts::FRAC_PI_2 {
+        return None;
+    }
+    let widest = a + v.spread + beta;
+    let least = widest.min(std::f32::consts::FRAC_PI_2).cos();
+    let most = (a - v.spread - beta).max(0.0).cos();
+    Some((least, most, widest < std::f32::consts::FRAC_PI_2))
+}
+
+/// Whether node `a` holds `b` (their member ranges nest).
+fn holds(a: &View, b: &View) -> bool {
+    a.first <= b.first && b.first + b.count <= a.first + a.count
+}
+
+fn push_children(tree: &Tree, node: Ref, mut push: impl FnMut(Ref)) {
+    let [a, b] = tree.nodes[node.index()].children;
+    push(b);
+    push(a);
+}
+
+/// SplitMix64's finaliser: a well-mixed hash of a 64-bit value.
+fn mix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}

@@ -1,0 +1,300 @@
+//! The hierarchical solver, the paper's future work: samples grouped in a cluster tree, linked
+//! cluster to cluster where an error bound allows and sample to sample elsewhere, and shot
+//! along those links, every sample's unshot power at once, sweep after sweep.
+//!
+//! A round: build the tree (`tree`), mark which nodes may stand for their members
+//! (`coherence`), cut the tree into receiver groups and build each group's links (`links`) in
+//! the pipeline, take every receiver's row sum from the links (one sweep with unit radiosity;
+//! see `normalise`), then sweep (`sweep`) until the unshot power is below the tolerance. The
+//! links and their visibility are built once per round and kept for all its sweeps; every
+//! structure grows with the number of links, which grows about linearly with the samples.
+//!
+//! Each receiver group is one job: its links, its sweeps' arithmetic and its samples' results
+//! depend on nothing else, and the coordinator applies the groups' results in order, so the
+//! answer is bit-identical for any number of workers.
+
+pub(crate) mod coherence;
+pub(crate) mod links;
+pub(crate) mod sweep;
+pub(crate) mod tree;
+
+use std::ops::ControlFlow;
+use std::sync::RwLock;
+
+use glam::DVec3;
+
+use self::coherence::Context;
+use self::links::{Linker, Links};
+use self::sweep::{shooters, Shooter, Sources};
+use self::tree::{Ref, Tree};
+use super::normalise::row_scale;
+use super::pipeline::with_pool;
+use super::progress::Control;
+use super::shooting::{unshot_power, Settings, State, Tick};
+use super::stats::{ShootStats, StopReason};
+use crate::error::Result;
+use crate::visibility::Visibility;
+
+/// Shooters darker than this fraction of the mean radiosity are weighed as this bright in the
+/// error bound: their light may grow in later sweeps (a room lit through a doorway).
+const DARK_WEIGHT: f64 = 0.2;
+
+/// Sweeps at most, unless `max_shots` says otherwise.
+pub(crate) const MAX_SWEEPS: u64 = 10_000;
+
+/// Samples per receiver group: enough groups to share among the workers, whatever their
+/// number (the groups must not depend on it, for determinism).
+fn group_size(n: usize) -> usize {
+    (n / 256).max(1024)
+}
+
+/// What a sweep reads (see `sweep::Sources`); no scales: unscaled.
+#[derive(Default)]
+struct Inputs {
+    unshot: Vec<DVec3>,
+    shooters: Vec<Shooter>,
+    scales: Vec<f32>,
+}
+
+/// One receiver group: its links, and what they delivered to its members in the last sweep.
+struct Group {
+    root: Ref,
+    links: Links,
+    delivered: Vec<DVec3>,
+}
+
+/// Shoots until converged, out of sweeps, or told to stop; `report` hears every group linked
+/// and every sweep.
+pub(crate) fn shoot(
+    state: &mut State,
+    vis: &dyn Visibility,
+    settings: &Settings,
+    cx: &Context,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<ShootStats> {
+    let samples = state.samples;
+    let n = samples.len();
+    let emitted = state.ledger.emitted.element_sum();
+    let mut stats = ShootStats::new();
+    if emitted <= 0.0 || n == 0 {
+        stats.stop = StopReason::NoLight;
+        return Ok(stats);
+    }
+
+    // Nothing to do where the warm start left less than the tolerance unshot.
+    let unshot: f64 = (0..n)
+        .map(|k| unshot_power(state.unshot[k], samples.area[k]))
+        .sum();
+    stats.initial_unshot_fraction = unshot / emitted;
+    stats.unshot_fraction = stats.initial_unshot_fraction;
+    if stats.unshot_fraction < settings.tolerance {
+        return Ok(stats);
+    }
+
+    // The tree, weighing each shooter by its radiosity (the mean radiosity is the reference
+    // the threshold is relative to).
+    let rho: Vec<f32> = state
+        .reflectance
+        .iter()
+        .map(|r| r.max_element() as f32)
+        .collect();
+    let brightness: Vec<f64> = state.radiosity.iter().map(|b| b.max_element()).collect();
+    let area: f64 = samples.area.iter().sum();
+    let reference = if area > 0.0 {
+        brightness
+            .iter()
+            .zip(&samples.area)
+            .map(|(b, a)| b * a)
+            .sum::<f64>()
+            / area
+    } else {
+        0.0
+    };
+    let weight: Vec<f64> = brightness
+        .iter()
+        .map(|&b| b.max(DARK_WEIGHT * reference))
+        .collect();
+    let tree = Tree::build(samples, &rho, &weight, cx);
+    debug_assert_eq!(tree.validate(samples), Ok(()));
+    let roots = tree.cut(group_size(n));
+    let threads = settings.threads.max(1);
+
+    // Links, group by group.
+    let linker = Linker {
+        tree: &tree,
+        samples,
+        maps: state.maps,
+        vis,
+        lift: settings.lift,
+        tolerance: settings.threshold * reference,
+        seed: settings.seed,
+    };
+    // Every pair of groups (each group with itself too), as jobs; each job's links go to
+    // its two groups, in job order.
+    let mut groups: Vec<Group> = roots
+        .iter()
+        .map(|&root| Group {
+            root,
+            links: Links::default(),
+            delivered: Vec::new(),
+        })
+        .collect();
+    let pairs: Vec<(usize, usize)> = (0..roots.len())
+        .flat_map(|x| (x..roots.len()).map(move |y| (x, y)))
+        .collect();
+    let link = |(x, y): (usize, usize)| linker.links_between(roots[x], roots[y]);
+    let total = pairs.len();
+    let flow = with_pool(threads, settings.capacity, &link, |pool| {
+        pool.run(pairs.iter().copied(), |job, (mut first, mut second)| {
+            let (x, y) = pairs[job];
+            stats.queries += first.queries + second.queries;
+            groups[x].links.append(&mut first);
+            groups[y].links.append(&mut second);
+            Ok(flow(report(Tick::linking((job + 1) as f64 / total as f64))))
+        })
+    })?;
+    for group in &mut groups {
+        group.links.leaf.shrink_to_fit();
+        group.links.cluster.shrink_to_fit();
+    }
+    stats.links = groups
+        .iter()
+        .map(|g| (g.links.leaf.len() + g.links.cluster.len()) as u64)
+        .sum();
+    stats.leaf_links = groups.iter().map(|g| g.links.leaf.len() as u64).sum();
+    let link_bytes: usize = groups.iter().map(|g| g.links.bytes()).sum();
+    if flow.is_break() {
+        stats.stop = StopReason::Stopped;
+        stats.bytes = link_bytes as u64;
+        return Ok(stats);
+    }
+
+    // What every group's sweep reads: written by the coordinator between sweeps, read by the
+    // workers during them.
+    let inputs = RwLock::new(Inputs::default());
+    let work = |mut group: Group| -> Result<Group> {
+        let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
+        let sources = Sources {
+            tree: &tree,
+            samples,
+            unshot: &inputs.unshot,
+            shooters: &inputs.shooters,
+        };
+        sources.gather(group.root, &group.links, &mut group.delivered);
+        if !inputs.scales.is_empty() {
+            let first = first_member(&tree, group.root);
+            for (p, h) in group.delivered.iter_mut().enumerate() {
+                *h *= f64::from(inputs.scales[tree.order[first + p] as usize]);
+            }
+        }
+        Ok(group)
+    };
+    let set = |unshot: &[DVec3], scales: &[f32]| {
+        let mut inputs = inputs.write().unwrap_or_else(|e| e.into_inner());
+        inputs.unshot.clear();
+        inputs.unshot.extend_from_slice(unshot);
+        inputs.shooters = shooters(&tree, samples, unshot);
+        inputs.scales.clear();
+        inputs.scales.extend_from_slice(scales);
+    };
+    with_pool(threads, settings.capacity, &work, |pool| {
+        // Row sums: one sweep with unit radiosity everywhere, unscaled.
+        if settings.normalise {
+            set(&vec![DVec3::ONE; n], &[]);
+            let mut kept = Vec::with_capacity(groups.len());
+            let mut sums = vec![0.0f64; n];
+            pool.run_all(groups.drain(..), |_, group| {
+                let first = first_member(&tree, group.root);
+                for (p, h) in group.delivered.iter().enumerate() {
+                    sums[tree.order[first + p] as usize] = h.x;
+                }
+                kept.push(group);
+                Ok(())
+            })?;
+            groups = kept;
+            for (i, scale) in state.row_scale.iter_mut().enumerate() {
+                *scale = row_scale(sums[i], state.closed[i]);
+            }
+        }
+
+        let max_sweeps = if settings.max_shots == u64::MAX {
+            MAX_SWEEPS
+        } else {
+            settings.max_shots
+        };
+        let mut first = true;
+        loop {
+            let total: f64 = (0..n)
+                .map(|k| unshot_power(state.unshot[k], samples.area[k]))
+                .sum();
+            stats.unshot_fraction = total / emitted;
+            if first {
+                stats.initial_unshot_fraction = stats.unshot_fraction;
+                first = false;
+            }
+            if stats.unshot_fraction.is_nan() || stats.unshot_fraction >= 1e6 {
+                stats.stop = StopReason::Diverged;
+                break;
+            }
+            if stats.unshot_fraction < settings.tolerance || total == 0.0 {
+                stats.stop = StopReason::Converged;
+                break;
+            }
+            if stats.shots >= max_sweeps {
+                stats.stop = StopReason::ShotLimit;
+                break;
+            }
+            if report(Tick::shooting(stats.shots, stats.unshot_fraction)) == Control::Stop {
+                stats.stop = StopReason::Stopped;
+                break;
+            }
+
+            // Every sample shoots its unshot radiosity along the links.
+            set(state.unshot, state.row_scale);
+            let shot: DVec3 = (0..n).map(|k| state.unshot[k] * samples.area[k]).sum();
+            let mut delivered = DVec3::ZERO;
+            let mut kept = Vec::with_capacity(groups.len());
+            let (irradiance, unshot) = (&mut *state.irradiance, &mut *state.unshot);
+            let reflectance = state.reflectance;
+            pool.run_all(groups.drain(..), |_, group| {
+                let first = first_member(&tree, group.root);
+                for (p, &h) in group.delivered.iter().enumerate() {
+                    let k = tree.order[first + p] as usize;
+                    irradiance[k] += h;
+                    unshot[k] = reflectance[k] * h;
+                    delivered += h * samples.area[k];
+                }
+                kept.push(group);
+                Ok(())
+            })?;
+            groups = kept;
+            state.ledger.escaped += shot - delivered;
+            stats.shots += 1;
+        }
+        Ok(())
+    })?;
+    let delivered: usize = groups
+        .iter()
+        .map(|g| g.delivered.capacity() * std::mem::size_of::<DVec3>())
+        .sum();
+    stats.bytes = (link_bytes
+        + delivered
+        + tree.nodes.len() * (std::mem::size_of::<tree::Node>() + std::mem::size_of::<Shooter>()))
+        as u64;
+    Ok(stats)
+}
+
+fn first_member(tree: &Tree, r: Ref) -> usize {
+    if r.is_leaf() {
+        tree.place[r.index()] as usize
+    } else {
+        tree.nodes[r.index()].first as usize
+    }
+}
+
+fn flow(control: Control) -> ControlFlow<()> {
+    match control {
+        Control::Continue => ControlFlow::Continue(()),
+        Control::Stop => ControlFlow::Break(()),
+    }
+}

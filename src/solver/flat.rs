@@ -1,0 +1,325 @@
+//! The flat solver: progressive radiosity between samples (method.md §5, after Cohen et al.
+//! 1988): repeatedly shoot the sample with the largest unshot power to every sample it can
+//! see. Every shooter is linked to every receiver, so a solve is O(N²); the cluster hierarchy
+//! (`cluster`) is what scales. It stays as the exact reference the hierarchy is checked
+//! against, and as `--cluster-threshold 0`.
+//!
+//! Row normalisation (see `normalise`): the first solve computes every shooter's form factors
+//! up front, for every receiver's row sum. New samples of later rounds take the scale of their
+//! nearest old sample.
+//!
+//! Jobs of fixed receiver ranges go through the pipeline; the coordinator applies the results
+//! in range order, so the answer is bit-identical for any thread count.
+//!
+//! A sample is usually shot several times before the unshot power converges; the visible
+//! receivers and form factors of each shooter are kept (up to a memory budget) so that only
+//! its first shot in a solve pays for visibility. And once a sample has shot, which samples
+//! see it is known: a later shooter reads its visibility to that sample from a bit matrix
+//! instead of asking again, so each pair is queried once, not twice. The bit matrix counts
+//! against the same budget.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+use crate::error::Result;
+use crate::sampling::Samples;
+use crate::visibility::Visibility;
+
+use super::form_factor::{segment, Shooter};
+use super::normalise::row_scale;
+use super::pipeline::with_pool;
+use super::progress::Control;
+use super::shooting::{unshot_power, Settings, State, Tick};
+use super::stats::{ShootStats, StopReason};
+
+/// Visibility already known: row j holds, once sample j has shot, which samples see it.
+/// Written by the coordinator between shots, read by workers during them (the channel hand-off
+/// orders the two), hence relaxed atomics.
+struct Memo {
+    n: usize,
+    shot: Vec<AtomicBool>,
+    bits: Vec<AtomicU64>,
+}
+
+impl Memo {
+    fn bytes(n: usize) -> usize {
+        (n * n).div_ceil(64) * 8 + n
+    }
+
+    fn new(n: usize) -> Memo {
+        let words = (n * n).div_ceil(64);
+        Memo {
+            n,
+            shot: (0..n).map(|_| AtomicBool::new(false)).collect(),
+            bits: (0..words).map(|_| AtomicU64::new(0)).collect(),
+        }
+    }
+
+    /// Whether i sees j, if i has shot (then its row is complete).
+    fn get(&self, i: usize, j: usize) -> Option<bool> {
+        if !self.shot[i].load(Ordering::Relaxed) {
+            return None;
+        }
+        let bit = i * self.n + j;
+        Some(self.bits[bit / 64].load(Ordering::Relaxed) & (1 << (bit % 64)) != 0)
+    }
+
+    fn record(&self, j: usize, visible: &[(u32, f32)]) {
+        for &(i, _) in visible {
+            let bit = j * self.n + i as usize;
+            self.bits[bit / 64].fetch_or(1 << (bit % 64), Ordering::Relaxed);
+        }
+        self.shot[j].store(true, Ordering::Relaxed);
+    }
+}
+
+/// A shooter's visible receivers with their form factors.
+type List = Box<[(u32, f32)]>;
+
+/// A list kept for later shots, with Σ F·S over it.
+type Kept = (List, f64);
+
+struct Job {
+    range: std::ops::Range<usize>,
+    shooter: Shooter,
+}
+
+struct Done {
+    /// (receiver, form factor) of every visible receiver in the range.
+    factors: Vec<(u32, f32)>,
+    queries: u64,
+}
+
+/// Shoots until converged, out of shots, or told to stop; `report` hears every few shots.
+pub(crate) fn shoot(
+    state: &mut State,
+    vis: &dyn Visibility,
+    settings: &Settings,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<ShootStats> {
+    let samples = state.samples;
+    let n = samples.len();
+    let emitted = state.ledger.emitted.element_sum();
+    let mut stats = ShootStats::new();
+    if emitted <= 0.0 || n == 0 {
+        stats.stop = StopReason::NoLight;
+        return Ok(stats);
+    }
+    let threads = settings.threads.max(1);
+    let chunk = n.div_ceil(4 * threads).max(512);
+    // The bit matrix is worth it within half the memory budget only.
+    let memo_bytes = Memo::bytes(n);
+    let memo = (memo_bytes <= settings.memory_bytes / 2).then(|| Memo::new(n));
+    let memo = memo.as_ref();
+    let ranges: Vec<std::ops::Range<usize>> = (0..n)
+        .step_by(chunk)
+        .map(|a| a..(a + chunk).min(n))
+        .collect();
+    let lift = settings.lift;
+    let work = |job: Job| factors(samples, vis, lift, job.shooter, job.range, memo);
+    // Every range of one shooter in flight at once, as before the pipeline existed.
+    let capacity = settings.capacity.min(ranges.len()).max(1);
+    with_pool(threads, capacity, &work, |pool| {
+        // One shooter's visible receivers and form factors, range by range, in receiver order.
+        let mut compute = |j: usize| -> Result<(List, u64)> {
+            let shooter = Shooter::of(samples, state.maps, j);
+            let mut list = Vec::new();
+            let mut queries = 0;
+            pool.run_all(
+                ranges.iter().map(|range| Job {
+                    range: range.clone(),
+                    shooter,
+                }),
+                |_, done| {
+                    list.extend_from_slice(&done.factors);
+                    queries += done.queries;
+                    Ok(())
+                },
+            )?;
+            if let Some(memo) = memo {
+                memo.record(j, &list);
+            }
+            Ok((list.into_boxed_slice(), queries))
+        };
+        let delivered_by = |list: &[(u32, f32)]| -> f64 {
+            list.iter()
+                .map(|&(i, f)| f64::from(f) * samples.area[i as usize])
+                .sum()
+        };
+
+        // Per shooter: its visible receivers with (row-scaled) form factors, and Σ F·S.
+        let mut cache: Vec<Option<Kept>> = vec![None; n];
+        let mut cache_left =
+            settings
+                .memory_bytes
+                .saturating_sub(if memo.is_some() { memo_bytes } else { 0 });
+        let mut held = memo.map_or(0, |_| memo_bytes);
+
+        if settings.normalise {
+            // Every receiver's row sum Σⱼ Fᵢⱼ, from every shooter's list.
+            let mut sums = vec![0.0f64; n];
+            for (j, slot) in cache.iter_mut().enumerate() {
+                if j % 256 == 0 && report(Tick::linking(j as f64 / n as f64)) == Control::Stop {
+                    stats.stop = StopReason::Stopped;
+                    return Ok(stats);
+                }
+                let (list, queries) = compute(j)?;
+                stats.queries += queries;
+                for &(i, f) in list.iter() {
+                    sums[i as usize] += f64::from(f);
+                }
+                let bytes = std::mem::size_of_val(&*list);
+                if bytes <= cache_left {
+                    cache_left -= bytes;
+                    held += bytes;
+                    *slot = Some((list, 0.0));
+                }
+            }
+            for (i, scale) in state.row_scale.iter_mut().enumerate() {
+                *scale = row_scale(sums[i], state.closed[i]);
+            }
+            for kept in cache.iter_mut().flatten() {
+                for (i, f) in kept.0.iter_mut() {
+                    *f *= state.row_scale[*i as usize];
+                }
+                kept.1 = delivered_by(&kept.0);
+            }
+        }
+
+        let mut first = true;
+        // Unshot power per sample, kept up to date as shots land: the shooter search is then
+        // one pass over a flat array.
+        let mut power: Vec<f64> = (0..n)
+            .map(|k| unshot_power(state.unshot[k], samples.area[k]))
+            .collect();
+        loop {
+            // The shooter: largest unshot power (lowest index on ties).
+            let mut total = 0.0;
+            let mut best = (0.0, usize::MAX);
+            for (k, &p) in power.iter().enumerate() {
+                total += p;
+                if p > best.0 {
+                    best = (p, k);
+                }
+            }
+            stats.unshot_fraction = total / emitted;
+            if stats.unshot_fraction.is_nan() || stats.unshot_fraction >= 1e6 {
+                stats.stop = StopReason::Diverged;
+                break;
+            }
+            if first {
+                stats.initial_unshot_fraction = stats.unshot_fraction;
+                first = false;
+            }
+            if stats.unshot_fraction < settings.tolerance || best.1 == usize::MAX {
+                stats.stop = StopReason::Converged;
+                break;
+            }
+            if stats.shots >= settings.max_shots {
+                stats.stop = StopReason::ShotLimit;
+                break;
+            }
+            if stats.shots % 32 == 0
+                && report(Tick::shooting(stats.shots, stats.unshot_fraction)) == Control::Stop
+            {
+                stats.stop = StopReason::Stopped;
+                break;
+            }
+            let j = best.1;
+
+            // This shooter's form factors, unless they are kept from before.
+            let mut keep = true;
+            if cache[j].is_none() {
+                let (mut list, queries) = compute(j)?;
+                stats.queries += queries;
+                for (i, f) in list.iter_mut() {
+                    *f *= state.row_scale[*i as usize];
+                }
+                let delivered = delivered_by(&list);
+                let bytes = std::mem::size_of_val(&*list);
+                // Over budget, the list serves this shot only.
+                keep = bytes <= cache_left;
+                if keep {
+                    cache_left -= bytes;
+                    held += bytes;
+                }
+                cache[j] = Some((list, delivered));
+            } else {
+                stats.cached_shots += 1;
+            }
+            let (list, delivered) = cache[j].as_ref().expect("filled above");
+
+            let db = state.unshot[j];
+            for &(i, f) in list.iter() {
+                let h = db * f64::from(f);
+                let i = i as usize;
+                state.irradiance[i] += h;
+                state.unshot[i] += state.reflectance[i] * h;
+                power[i] = unshot_power(state.unshot[i], samples.area[i]);
+            }
+            state.ledger.escaped += db * (samples.area[j] - delivered);
+            if !keep {
+                cache[j] = None;
+            }
+            state.unshot[j] = glam::DVec3::ZERO;
+            power[j] = 0.0;
+            stats.shots += 1;
+        }
+        stats.bytes = held as u64;
+        Ok(stats)
+    })
+}
+
+/// Form factors from every sample that sees sample `j` to `j`'s region: (receiver, F).
+pub(crate) fn form_factors(
+    samples: &Samples,
+    maps: &[crate::sampling::SurfaceMap],
+    vis: &dyn Visibility,
+    lift: f32,
+    j: usize,
+) -> Result<Vec<(u32, f32)>> {
+    let shooter = Shooter::of(samples, maps, j);
+    Ok(factors(samples, vis, lift, shooter, 0..samples.len(), None)?.factors)
+}
+
+/// Form factors from every visible receiver in `range` to the shooter's region.
+fn factors(
+    samples: &Samples,
+    vis: &dyn Visibility,
+    lift: f32,
+    shooter: Shooter,
+    range: std::ops::Range<usize>,
+    memo: Option<&Memo>,
+) -> Result<Done> {
+    let mut candidates = Vec::new();
+    let mut known = Vec::new();
+    let mut segments = Vec::new();
+    let j = shooter.index as usize;
+    for i in range {
+        if i == j {
+            continue;
+        }
+        let Some(f) = shooter.factor_to(samples, i) else {
+            continue;
+        };
+        let memory = memo.and_then(|m| m.get(i, j));
+        if memory.is_none() {
+            segments.push(segment(samples, lift, j, i));
+        }
+        known.push(memory);
+        candidates.push((i as u32, f));
+    }
+    let mut blocked = vec![false; segments.len()];
+    vis.occluded(&segments, &mut blocked)?;
+    let mut answers = blocked.into_iter();
+    let mut factors = Vec::with_capacity(candidates.len());
+    for (c, memory) in candidates.into_iter().zip(known) {
+        let visible = memory.unwrap_or_else(|| !answers.next().unwrap_or(true));
+        if visible {
+            factors.push(c);
+        }
+    }
+    Ok(Done {
+        factors,
+        queries: segments.len() as u64,
+    })
+}

@@ -1,0 +1,89 @@
+//! Row normalisation: at albedo ρ a relative error δ in a receiver's Σⱼ Fᵢⱼ becomes an error of
+//! about ρδ/(1 − ρ) in its radiance (100δ at ρ = 0.99). Each receiver's row of form factors is
+//! therefore scaled: to sum to exactly 1 where all probe rays from the receiver hit a reflecting
+//! side (a closed hemisphere), and to at most 1 elsewhere. Rows summing to at most 1 also make
+//! the iteration a contraction for any ρ < 1, so energy can never build up.
+
+use rand::{RngExt, SeedableRng};
+
+use crate::error::Result;
+use crate::parallel::for_chunks;
+use crate::sampling::{poisson, Samples};
+use crate::scene::Scene;
+use crate::visibility::{Ray, Visibility};
+
+/// Probe rays per sample for [`closed_hemispheres`].
+const PROBES: u32 = 32;
+
+/// The factor a receiver's form factors are scaled by, from their raw sum and whether its
+/// hemisphere is closed.
+pub(crate) fn row_scale(sum: f64, closed: bool) -> f32 {
+    // A closed row off by more than a fifth is not a discretisation error to correct
+    // (something hides what the probes saw): then only cap it.
+    if sum <= 0.0 {
+        1.0
+    } else if closed && (0.8..1.25).contains(&sum) {
+        (1.0 / sum) as f32
+    } else {
+        (1.0 / sum).min(1.0) as f32
+    }
+}
+
+/// For samples `first..`, whether all of [`PROBES`] cosine-distributed (stratified) rays from
+/// each hit a reflecting surface side (one that has samples): only then do the receiver's form
+/// factors have to cover its whole hemisphere. A probe that escapes, or meets a black side (the
+/// back of a light, say), leaves the row unnormalised. Rays, not segments: a segment ignores
+/// hits near its ends, which lets a probe from a sample beside an edge slip past the
+/// neighbouring face.
+pub(crate) fn closed_hemispheres(
+    scene: &Scene,
+    reflecting: &[bool],
+    samples: &Samples,
+    first: usize,
+    vis: &dyn Visibility,
+    (seed, threads): (u64, usize),
+    lift: f32,
+) -> Result<Vec<bool>> {
+    let diagonal = scene.bounds.diagonal();
+    let mut out = vec![true; samples.len() - first];
+    for_chunks(&mut out, 128, threads, |start, chunk| {
+        let mut rays = Vec::with_capacity(chunk.len() * PROBES as usize);
+        for k in first + start..first + start + chunk.len() {
+            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(poisson::side_seed(seed, k as u32, 11));
+            let n = samples.normal[k];
+            let (t, b) = n.any_orthonormal_pair();
+            let from = samples.position[k] + lift * n;
+            let rows = PROBES / 4;
+            for i in 0..PROBES {
+                // Stratified over (radius², angle): cosine-weighted directions.
+                let u = ((i / 4) as f32 + rng.random::<f32>()) / rows as f32;
+                let v = ((i % 4) as f32 + rng.random::<f32>()) / 4.0;
+                let (r, phi) = (u.sqrt(), v * std::f32::consts::TAU);
+                let d = t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u).max(0.0).sqrt();
+                rays.push(Ray {
+                    origin: from,
+                    dir: d,
+                    t_min: 0.0,
+                    t_max: 2.0 * diagonal,
+                });
+            }
+        }
+        let mut hits = vec![None; rays.len()];
+        vis.intersect(&rays, &mut hits)?;
+        for ((o, hits), rays) in chunk
+            .iter_mut()
+            .zip(hits.chunks(PROBES as usize))
+            .zip(rays.chunks(PROBES as usize))
+        {
+            *o = hits.iter().zip(rays).all(|(hit, ray)| {
+                hit.is_some_and(|h| {
+                    let t = &scene.triangles[h.triangle as usize];
+                    let side = crate::sampling::side_of(t.surface, ray.dir.dot(t.normal) > 0.0);
+                    reflecting[side as usize]
+                })
+            });
+        }
+        Ok(())
+    })?;
+    Ok(out)
+}

@@ -1,0 +1,88 @@
+//! Warm starts: after adaptive rounds add samples and areas are recomputed, the light already
+//! shot is taken to be the old samples' shot radiosity (R − ΔB) spread over the new areas: old
+//! samples keep their unshot ΔB; a new sample gets its exact direct light plus indirect light
+//! interpolated from its old neighbours, and its unshot radiosity is the difference between
+//! that and the shot radiosity interpolated at its place. Shooting then only carries the
+//! corrections the new samples bring (mostly sharper direct light), not the whole solution
+//! again.
+
+use glam::DVec3;
+
+use super::Solution;
+use crate::error::Result;
+use crate::light::Arrival;
+use crate::sampling::{is_back, surface_of, Samples};
+use crate::scene::Scene;
+use crate::visibility::Visibility;
+
+/// Diffuse reflectance of sample k's surface.
+pub(crate) fn reflectance(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
+    scene.material_of(surface_of(samples.side[k])).kd.as_dvec3()
+}
+
+/// Emitted radiosity π·Ke of sample k (emitters emit from their front only).
+pub(crate) fn emission(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
+    let side = samples.side[k];
+    if is_back(side) {
+        return DVec3::ZERO;
+    }
+    std::f64::consts::PI * scene.material_of(surface_of(side)).ke.as_dvec3()
+}
+
+/// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their
+/// unshot radiosity for a (warm) start: see the module doc.
+pub(crate) fn start(
+    scene: &Scene,
+    solution: &mut Solution,
+    vis: &dyn Visibility,
+    first_new: usize,
+    arrivals: &[Arrival],
+    epsilon: f32,
+    alpha: f32,
+) -> Result<()> {
+    let n = solution.samples.len();
+    let samples = &solution.samples;
+    let mut near = Vec::new();
+    let r = 2.0 * epsilon;
+    for (a, k) in arrivals.iter().zip(first_new..n) {
+        let rho = reflectance(scene, samples, k);
+        // Interpolated from the old samples: indirect irradiance, and radiosity already shot.
+        let (mut wsum, mut indirect, mut shot) = (0.0, DVec3::ZERO, DVec3::ZERO);
+        if first_new > 0 {
+            solution
+                .index
+                .within(samples, samples.side[k], samples.uv[k], r, &mut near);
+            near.retain(|&(j, _)| (j as usize) < first_new);
+            near.sort_unstable_by_key(|&(j, _)| j);
+            let side = samples.side[k];
+            solution.obstruction.retain_visible(
+                vis,
+                &solution.maps,
+                samples,
+                side,
+                samples.position[k],
+                &mut near,
+            )?;
+            for &(j, d2) in &near {
+                let j = j as usize;
+                let w = f64::from((-alpha * d2.sqrt() / r).exp());
+                wsum += w;
+                indirect += w * (solution.irradiance[j] - solution.direct[j].irradiance);
+                shot += w * (rho * solution.irradiance[j] - solution.unshot[j]);
+            }
+        }
+        if wsum > 0.0 {
+            indirect /= wsum;
+            shot /= wsum;
+        }
+        let h = a.irradiance + indirect;
+        solution.direct.push(*a);
+        solution.irradiance.push(h);
+        solution.unshot.push(rho * h - shot);
+        solution
+            .radiosity
+            .push(emission(scene, samples, k) + rho * h);
+    }
+    debug_assert_eq!(solution.irradiance.len(), n);
+    Ok(())
+}
