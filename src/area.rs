@@ -14,6 +14,7 @@
 use glam::{DVec3, Vec2};
 
 use crate::error::Result;
+use crate::parallel::for_chunks;
 use crate::sampling::{surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::visibility::Visibility;
 
@@ -28,15 +29,20 @@ pub struct AreaStats {
     pub queries: u64,
 }
 
-/// Computes every sample's area `S`.
+/// Computes every sample's area `S`, on up to `threads` threads (the result does not depend
+/// on their number). With `changed` (per side), only the sides it marks are recomputed: the
+/// others keep the cells and shares the last computation gave them (their samples and radii
+/// must not have changed since).
+#[allow(clippy::too_many_arguments)]
 pub fn compute(
     samples: &mut Samples,
     maps: &[SurfaceMap],
     index: &SideIndex,
     obstruction: &Obstruction,
     vis: &dyn Visibility,
-    epsilon: f32,
-    alpha: f32,
+    (epsilon, alpha): (f32, f32),
+    threads: usize,
+    changed: Option<&[bool]>,
 ) -> Result<AreaStats> {
     // ε bounds the cell size where a side has only initial samples.
     let mut stats = AreaStats::default();
@@ -48,94 +54,233 @@ pub fn compute(
         smallest[side as usize] = smallest[side as usize].min(d);
         count[side as usize] += 1;
     }
-    let mut area = vec![0.0f64; samples.len()];
-    // Every share, (sample, cell, area): the regions that carry the near-field form factors.
-    let mut shares: Vec<(u32, u32, f32)> = Vec::new();
-    let mut all_cells: Vec<AreaCell> = Vec::new();
-    let mut near = Vec::new();
-    let mut cells: Vec<(u64, f64, Vec2)> = Vec::new();
-    for side in 0..sides {
-        if count[side] == 0 {
-            continue;
+    // The cells the last computation left on each side, to keep where nothing changed.
+    let redo = |side: usize| changed.is_none_or(|c| c.get(side).copied().unwrap_or(true));
+    let mut kept: Vec<std::ops::Range<usize>> = vec![0..0; sides];
+    if changed.is_some() {
+        let mut at = 0;
+        while at < samples.cells.len() {
+            let side = samples.cells[at].side as usize;
+            let end = at
+                + samples.cells[at..]
+                    .iter()
+                    .take_while(|c| c.side as usize == side)
+                    .count();
+            if side < sides {
+                kept[side] = at..end;
+            }
+            at = end;
+        }
+    }
+    // Every changed side's cells, clipped side by side in parallel: (cell size, cells).
+    let active: Vec<usize> = (0..sides).filter(|&side| count[side] > 0).collect();
+    let mut clipped: Vec<Clipped> = vec![(0.0, Vec::new()); active.len()];
+    for_chunks(&mut clipped, 1, threads, |i, out| {
+        let side = active[i];
+        if !redo(side) {
+            return Ok(());
         }
         let map = &maps[surface_of(side as u32) as usize];
         let cell = cell_size(map, epsilon.min(smallest[side]), count[side]);
-        clip_cells(map, cell, &mut cells);
-
-        stats.cells += cells.len();
-        for &(_, a, centroid) in &cells {
-            let id = all_cells.len() as u32;
+        out[0].0 = cell;
+        clip_cells(map, cell, &mut out[0].1);
+        Ok(())
+    })?;
+    // The new cell list, side by side: kept cells where a side did not change (each with its
+    // old index), new ones (to split among samples) elsewhere.
+    let mut cells: Vec<(u32, f64, Vec2)> = Vec::new();
+    let mut old: Vec<Option<u32>> = Vec::new();
+    let mut all_cells: Vec<AreaCell> = Vec::new();
+    for (&side, (cell, list)) in active.iter().zip(&clipped) {
+        if !redo(side) {
+            for i in kept[side].clone() {
+                all_cells.push(samples.cells[i]);
+                cells.push((side as u32, 0.0, Vec2::ZERO));
+                old.push(Some(i as u32));
+            }
+            continue;
+        }
+        let map = &maps[surface_of(side as u32) as usize];
+        for &(_, a, centroid) in list {
+            cells.push((side as u32, a, centroid));
+            old.push(None);
             all_cells.push(AreaCell {
                 centroid: map.to_3d(centroid),
                 area: a as f32,
                 half: 0.5 * cell,
+                side: side as u32,
             });
-            let Some(nearest) = index.nearest(samples, side as u32, centroid) else {
-                continue;
-            };
-            let r = 2.0 * samples.radius[nearest as usize];
-            index.within(samples, side as u32, centroid, r, &mut near);
-            let point = map.to_3d(centroid);
-            stats.queries +=
-                obstruction.retain_visible(vis, maps, samples, side as u32, point, &mut near)?;
-            if near.is_empty() {
-                // Sealed off within R: the nearest sample it sees further out, else the nearest.
-                stats.orphan_cells += 1;
-                index.within(samples, side as u32, centroid, 4.0 * r, &mut near);
-                near.sort_unstable_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)));
-                near.truncate(16);
-                stats.queries += obstruction.retain_visible(
-                    vis,
-                    maps,
-                    samples,
-                    side as u32,
-                    point,
-                    &mut near,
-                )?;
-                let k = near.first().map_or(nearest, |n| n.0);
-                area[k as usize] += a;
-                shares.push((k, id, a as f32));
-                continue;
-            }
-            // Ascending sample order: the sum does not depend on the grid's iteration order.
-            near.sort_unstable_by_key(|&(k, _)| k);
-            let weight = |d2: f32| f64::from((-alpha * d2.sqrt() / r).exp());
-            let total: f64 = near.iter().map(|&(_, d2)| weight(d2)).sum();
-            for &(k, d2) in &near {
-                let share = a * weight(d2) / total;
-                area[k as usize] += share;
-                shares.push((k, id, share as f32));
-            }
         }
     }
-    // Group the shares by sample (stable: in cell order within each sample).
-    shares.sort_by_key(|&(k, _, _)| k);
+    drop(clipped);
+    stats.cells = cells.len();
+    // Where each kept cell went.
+    let mut moved = vec![u32::MAX; samples.cells.len()];
+    for (new, o) in old.iter().enumerate() {
+        if let Some(o) = o {
+            moved[*o as usize] = new as u32;
+        }
+    }
+
+    // Each new cell split among its samples (eq. 5), in parallel chunks of cells; each chunk's
+    // shares (cell, sample, area) in cell order.
+    let cx = Shares {
+        samples,
+        maps,
+        index,
+        obstruction,
+        vis,
+        alpha,
+    };
+    const CHUNK: usize = 1024;
+    let mut chunks: Vec<CellShares> = vec![CellShares::default(); cells.len().div_ceil(CHUNK)];
+    for_chunks(&mut chunks, 1, threads, |c, out| {
+        let mut near = Vec::new();
+        for id in c * CHUNK..((c + 1) * CHUNK).min(cells.len()) {
+            if old[id].is_none() {
+                let (side, a, centroid) = cells[id];
+                let map = &maps[surface_of(side) as usize];
+                cx.of_cell(id as u32, side, map, a, centroid, &mut near, &mut out[0])?;
+            }
+        }
+        Ok(())
+    })?;
+
+    // Gather the shares by sample, in cell order within each sample (a counting sort): a sample
+    // on a kept side keeps its shares (their cells renumbered), the others take the new ones.
     let n = samples.len();
-    samples.share_start = vec![0; n + 1];
-    for &(k, _, _) in &shares {
-        samples.share_start[k as usize + 1] += 1;
-    }
+    let kept_sample =
+        |k: usize| !redo(samples.side[k] as usize) && k + 1 < samples.share_start.len();
+    let mut start = vec![0u32; n + 1];
     for k in 0..n {
-        samples.share_start[k + 1] += samples.share_start[k];
-    }
-    samples.shares = shares.into_iter().map(|(_, c, a)| (c, a)).collect();
-    samples.cells = all_cells;
-    for k in 0..n {
-        let mut mass = 0.0f64;
-        let mut sum = DVec3::ZERO;
-        for &(c, a) in samples.shares_of(k) {
-            mass += f64::from(a);
-            sum += f64::from(a) * samples.cells[c as usize].centroid.as_dvec3();
+        if kept_sample(k) {
+            start[k + 1] = samples.shares_of(k).len() as u32;
         }
-        samples.centroid[k] = if mass > 0.0 {
-            (sum / mass).as_vec3()
-        } else {
-            samples.position[k]
-        };
     }
+    for chunk in &chunks {
+        stats.queries += chunk.queries;
+        stats.orphan_cells += chunk.orphans;
+        for &(_, k, _) in &chunk.shares {
+            start[k as usize + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut shares = vec![(0u32, 0.0f32); start[n] as usize];
+    let mut area = vec![0.0f64; n];
+    let mut next = start.clone();
+    for k in 0..n {
+        if kept_sample(k) {
+            for &(c, a) in samples.shares_of(k) {
+                area[k] += f64::from(a);
+                shares[next[k] as usize] = (moved[c as usize], a);
+                next[k] += 1;
+            }
+        }
+    }
+    for chunk in chunks {
+        for (id, k, share) in chunk.shares {
+            let k = k as usize;
+            area[k] += share;
+            shares[next[k] as usize] = (id, share as f32);
+            next[k] += 1;
+        }
+    }
+    samples.share_start = start;
+    samples.shares = shares;
+    samples.cells = all_cells;
+    let mut centroids = std::mem::take(&mut samples.centroid);
+    let shared: &Samples = samples;
+    for_chunks(&mut centroids, 4096, threads, |first, chunk| {
+        for (c, k) in chunk.iter_mut().zip(first..) {
+            let mut mass = 0.0f64;
+            let mut sum = DVec3::ZERO;
+            for &(cell, a) in shared.shares_of(k) {
+                mass += f64::from(a);
+                sum += f64::from(a) * shared.cells[cell as usize].centroid.as_dvec3();
+            }
+            *c = if mass > 0.0 {
+                (sum / mass).as_vec3()
+            } else {
+                shared.position[k]
+            };
+        }
+        Ok(())
+    })?;
+    samples.centroid = centroids;
     samples.area = area;
     Ok(stats)
 }
+
+/// The shares of a run of cells: (cell, sample, area) in cell order.
+#[derive(Clone, Debug, Default)]
+struct CellShares {
+    shares: Vec<(u32, u32, f64)>,
+    /// Cells with no visible sample within R, given to the nearest one.
+    orphans: usize,
+    queries: u64,
+}
+
+/// What splitting a cell among samples reads.
+struct Shares<'a> {
+    samples: &'a Samples,
+    maps: &'a [SurfaceMap],
+    index: &'a SideIndex,
+    obstruction: &'a Obstruction,
+    vis: &'a dyn Visibility,
+    alpha: f32,
+}
+
+impl Shares<'_> {
+    /// Splits cell `id` of area `a` at `centroid` (2D, on `side`) among the samples of the
+    /// side within R of it (eq. 5), into `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn of_cell(
+        &self,
+        id: u32,
+        side: u32,
+        map: &SurfaceMap,
+        a: f64,
+        centroid: Vec2,
+        near: &mut Vec<(u32, f32)>,
+        out: &mut CellShares,
+    ) -> Result<()> {
+        let (samples, index) = (self.samples, self.index);
+        let Some(nearest) = index.nearest(samples, side, centroid) else {
+            return Ok(());
+        };
+        let r = 2.0 * samples.radius[nearest as usize];
+        index.within(samples, side, centroid, r, near);
+        let point = map.to_3d(centroid);
+        out.queries += self
+            .obstruction
+            .retain_visible(self.vis, self.maps, samples, side, point, near)?;
+        if near.is_empty() {
+            // Sealed off within R: the nearest sample it sees further out, else the nearest.
+            out.orphans += 1;
+            index.within(samples, side, centroid, 4.0 * r, near);
+            near.sort_unstable_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)));
+            near.truncate(16);
+            out.queries += self
+                .obstruction
+                .retain_visible(self.vis, self.maps, samples, side, point, near)?;
+            let k = near.first().map_or(nearest, |n| n.0);
+            out.shares.push((id, k, a));
+            return Ok(());
+        }
+        // Ascending sample order: the sum does not depend on the grid's iteration order.
+        near.sort_unstable_by_key(|&(k, _)| k);
+        let weight = |d2: f32| f64::from((-self.alpha * d2.sqrt() / r).exp());
+        let total: f64 = near.iter().map(|&(_, d2)| weight(d2)).sum();
+        out.shares
+            .extend(near.iter().map(|&(k, d2)| (id, k, a * weight(d2) / total)));
+        Ok(())
+    }
+}
+
+/// A side's clipped cells: the grid's cell size, and (key, area, centroid) of each cell.
+type Clipped = (f32, Vec<(u64, f64, Vec2)>);
 
 /// Cells a third of the smallest spacing wide, but no more than ~16 per sample of the side.
 fn cell_size(map: &SurfaceMap, spacing: f32, samples: usize) -> f32 {

@@ -18,6 +18,7 @@ use rand_pcg::Pcg64Mcg;
 use super::poisson::side_seed;
 use super::{surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::error::Result;
+use crate::parallel::for_chunks;
 use crate::visibility::Visibility;
 
 /// Radii stop shrinking at ε / MAX_SPLIT.
@@ -50,6 +51,8 @@ pub struct RefineSettings {
     pub zeta: f32,
     /// Area weight parameter α (eq. 5), used for eq. 8's weights.
     pub alpha: f32,
+    /// Threads for the errors (the result does not depend on their number).
+    pub threads: usize,
     /// Round number stored in new samples.
     pub round: u16,
     /// Seed.
@@ -59,7 +62,7 @@ pub struct RefineSettings {
 }
 
 /// Eq. 7's error of every sample, relative to the mean luminance of `radiosity`; NaN where a
-/// sample has no neighbour within 2D that it sees along its side.
+/// sample has no neighbour within 2D that it sees along its side. On up to `threads` threads.
 pub fn errors(
     samples: &Samples,
     maps: &[SurfaceMap],
@@ -67,12 +70,14 @@ pub fn errors(
     obstruction: &Obstruction,
     vis: &dyn Visibility,
     radiosity: &[DVec3],
+    threads: usize,
 ) -> Result<Vec<f64>> {
     let n = samples.len();
     let mean = radiosity.iter().map(|&b| luminance(b)).sum::<f64>() / n.max(1) as f64;
-    let mut near = Vec::new();
-    (0..n)
-        .map(|k| {
+    let mut out = vec![0.0; n];
+    for_chunks(&mut out, 1024, threads, |first, chunk| {
+        let mut near = Vec::new();
+        for (e, k) in chunk.iter_mut().zip(first..) {
             let (side, uv, d) = (samples.side[k], samples.uv[k], samples.radius[k]);
             index.within(samples, side, uv, 2.0 * d, &mut near);
             obstruction.retain_visible(vis, maps, samples, side, samples.position[k], &mut near)?;
@@ -84,13 +89,15 @@ pub fn errors(
                     count += 1;
                 }
             }
-            Ok(if count == 0 || mean <= 0.0 {
+            *e = if count == 0 || mean <= 0.0 {
                 f64::NAN
             } else {
                 sum / count as f64 / mean
-            })
-        })
-        .collect()
+            };
+        }
+        Ok(())
+    })?;
+    Ok(out)
 }
 
 /// Refines where the error exceeds ζ: shrinks those samples' radii and adds new samples
@@ -104,7 +111,15 @@ pub fn refine(
     radiosity: &[DVec3],
     settings: RefineSettings,
 ) -> Result<Refinement> {
-    let errors = errors(samples, maps, index, obstruction, vis, radiosity)?;
+    let errors = errors(
+        samples,
+        maps,
+        index,
+        obstruction,
+        vis,
+        radiosity,
+        settings.threads,
+    )?;
     let mut result = Refinement::default();
     let eps = settings.epsilon;
     let min_radius = eps / MAX_SPLIT;
@@ -133,11 +148,62 @@ pub fn refine(
         discs.push((k, old_radius, m as u32));
         result.refined += 1;
     }
-    // New samples so far, per (side, cell of ε/2), to test spacing against them too.
+    // The discs side by side (each side's in sample order), filled side by side in parallel:
+    // a new sample is tested against the old samples and its own side's new ones only.
+    discs.sort_by_key(|&(k, _, _)| (samples.side[k], k));
+    let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
+    for (i, &(k, _, _)) in discs.iter().enumerate() {
+        match groups.last_mut() {
+            Some(g) if samples.side[discs[g.start].0] == samples.side[k] => g.end = i + 1,
+            _ => groups.push(i..i + 1),
+        }
+    }
+    let mut placed: Vec<Vec<(Vec2, f32)>> = vec![Vec::new(); groups.len()];
+    let shared: &Samples = samples;
+    for_chunks(&mut placed, 1, settings.threads, |g, out| {
+        out[0] = fill_discs(
+            shared,
+            maps,
+            index,
+            &discs[groups[g].clone()],
+            settings,
+            old,
+        );
+        Ok(())
+    })?;
+    'sides: for (group, points) in groups.iter().zip(placed) {
+        let side = samples.side[discs[group.start].0];
+        for (p, radius) in points {
+            if samples.len() >= settings.max_samples {
+                result.capped = true;
+                break 'sides;
+            }
+            samples.push(maps, side, p, radius, settings.round);
+            result.added += 1;
+        }
+    }
+    Ok(result)
+}
+
+/// Eq. 8's Poisson-disk darts in the discs of one side, in order: the new points with their
+/// radii. `old` is the number of samples before this refinement.
+fn fill_discs(
+    samples: &Samples,
+    maps: &[SurfaceMap],
+    index: &SideIndex,
+    discs: &[(usize, f32, u32)],
+    settings: RefineSettings,
+    old: usize,
+) -> Vec<(Vec2, f32)> {
+    let eps = settings.epsilon;
+    let min_radius = eps / MAX_SPLIT;
     let cell = eps / 2.0;
-    let mut added: HashMap<(u32, i32, i32), Vec<u32>> = HashMap::new();
     let r_weights = 2.0 * eps;
-    'discs: for &(k, old_radius, m) in &discs {
+    let mut near = Vec::new();
+    let mut out: Vec<(Vec2, f32)> = Vec::new();
+    // The new points so far, per cell of ε/2, to test spacing against them too.
+    let mut added: HashMap<(i32, i32), Vec<u32>> = HashMap::new();
+    for &(k, old_radius, m) in discs {
         let side = samples.side[k];
         let map = &maps[surface_of(side) as usize];
         let centre = samples.uv[k];
@@ -178,26 +244,18 @@ pub fn refine(
             let reach = (radius / cell).ceil() as i32;
             let clash = (cy - reach..=cy + reach).any(|y| {
                 (cx - reach..=cx + reach).any(|x| {
-                    added.get(&(side, x, y)).is_some_and(|list| {
+                    added.get(&(x, y)).is_some_and(|list| {
                         list.iter()
-                            .any(|&j| samples.uv[j as usize].distance_squared(p) < r2)
+                            .any(|&j| out[j as usize].0.distance_squared(p) < r2)
                     })
                 })
             });
             if clash {
                 continue;
             }
-            if samples.len() >= settings.max_samples {
-                result.capped = true;
-                break 'discs;
-            }
-            added
-                .entry((side, cx, cy))
-                .or_default()
-                .push(samples.len() as u32);
-            samples.push(maps, side, p, radius, settings.round);
-            result.added += 1;
+            added.entry((cx, cy)).or_default().push(out.len() as u32);
+            out.push((p, radius));
         }
     }
-    Ok(result)
+    out
 }

@@ -126,6 +126,8 @@ pub struct AreaCell {
     pub area: f32,
     /// Half the side of the grid cell it was cut from.
     pub half: f32,
+    /// The side it lies on.
+    pub side: Side,
 }
 
 impl Samples {

@@ -216,9 +216,10 @@ pub fn solve(
         refined: 0,
         capped: false,
         seconds: t.elapsed().as_secs_f64(),
+        changed: None,
     };
     for round in 0..=options.rounds {
-        let stats = solve.round(&mut solution, round, added)?;
+        let stats = solve.round(&mut solution, round, &added)?;
         solution.rounds.push(stats);
         if stats.shooting.stop == StopReason::Stopped || round == options.rounds || stats.capped {
             break;
@@ -245,12 +246,14 @@ struct Solve<'a> {
 }
 
 /// Samples an adaptive step (or the initial placement) added.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct AddedSamples {
     added: usize,
     refined: usize,
     capped: bool,
     seconds: f64,
+    /// Per side: whether it has new samples or changed radii (`None`: every side is new).
+    changed: Option<Vec<bool>>,
 }
 
 impl Solve<'_> {
@@ -299,7 +302,7 @@ impl Solve<'_> {
         &mut self,
         solution: &mut Solution,
         round: u32,
-        added: AddedSamples,
+        added: &AddedSamples,
     ) -> Result<RoundStats> {
         let (scene, vis, options) = (self.scene, self.vis, self.options);
         let threads = options.threads.max(1);
@@ -320,8 +323,9 @@ impl Solve<'_> {
             &solution.index,
             &solution.obstruction,
             vis,
-            self.epsilon,
-            options.alpha,
+            (self.epsilon, options.alpha),
+            threads,
+            added.changed.as_deref(),
         )?;
         seconds.areas = t.elapsed().as_secs_f64();
 
@@ -344,6 +348,7 @@ impl Solve<'_> {
             &arrivals,
             self.epsilon,
             options.alpha,
+            threads,
         )?;
         if round == 0 {
             // Direct light that reached no sample area left the scene.
@@ -480,6 +485,7 @@ impl Solve<'_> {
             return Ok(None);
         }
         let options = self.options;
+        let radii = solution.samples.radius.clone();
         let refinement = adaptive::refine(
             &mut solution.samples,
             &solution.maps,
@@ -491,16 +497,25 @@ impl Solve<'_> {
                 epsilon: self.epsilon,
                 zeta: options.zeta,
                 alpha: options.alpha,
+                threads: options.threads.max(1),
                 round: round as u16,
                 seed: options.seed,
                 max_samples: options.max_samples,
             },
         )?;
+        let samples = &solution.samples;
+        let mut changed = vec![false; 2 * solution.maps.len()];
+        for k in 0..samples.len() {
+            if radii.get(k) != Some(&samples.radius[k]) {
+                changed[samples.side[k] as usize] = true;
+            }
+        }
         Ok(Some(AddedSamples {
             added: refinement.added,
             refined: refinement.refined,
             capped: refinement.capped,
             seconds: t.elapsed().as_secs_f64(),
+            changed: Some(changed),
         }))
     }
 }

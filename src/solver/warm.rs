@@ -11,6 +11,7 @@ use glam::DVec3;
 use super::Solution;
 use crate::error::Result;
 use crate::light::Arrival;
+use crate::parallel::for_chunks;
 use crate::sampling::{is_back, surface_of, Samples};
 use crate::scene::Scene;
 use crate::visibility::Visibility;
@@ -30,7 +31,8 @@ pub(crate) fn emission(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
 }
 
 /// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their
-/// unshot radiosity for a (warm) start: see the module doc.
+/// unshot radiosity for a (warm) start: see the module doc. On up to `threads` threads.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn start(
     scene: &Scene,
     solution: &mut Solution,
@@ -39,49 +41,56 @@ pub(crate) fn start(
     arrivals: &[Arrival],
     epsilon: f32,
     alpha: f32,
+    threads: usize,
 ) -> Result<()> {
     let n = solution.samples.len();
-    let samples = &solution.samples;
-    let mut near = Vec::new();
-    let r = 2.0 * epsilon;
-    for (a, k) in arrivals.iter().zip(first_new..n) {
-        let rho = reflectance(scene, samples, k);
-        // Interpolated from the old samples: indirect irradiance, and radiosity already shot.
-        let (mut wsum, mut indirect, mut shot) = (0.0, DVec3::ZERO, DVec3::ZERO);
-        if first_new > 0 {
-            solution
-                .index
-                .within(samples, samples.side[k], samples.uv[k], r, &mut near);
-            near.retain(|&(j, _)| (j as usize) < first_new);
-            near.sort_unstable_by_key(|&(j, _)| j);
-            let side = samples.side[k];
-            solution.obstruction.retain_visible(
-                vis,
-                &solution.maps,
-                samples,
-                side,
-                samples.position[k],
-                &mut near,
-            )?;
-            for &(j, d2) in &near {
-                let j = j as usize;
-                let w = f64::from((-alpha * d2.sqrt() / r).exp());
-                wsum += w;
-                indirect += w * (solution.irradiance[j] - solution.direct[j].irradiance);
-                shot += w * (rho * solution.irradiance[j] - solution.unshot[j]);
+    // (irradiance, unshot, radiosity) of each new sample.
+    let mut out = vec![(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); n - first_new];
+    let shared: &Solution = solution;
+    for_chunks(&mut out, 256, threads, |first, chunk| {
+        let samples = &shared.samples;
+        let mut near = Vec::new();
+        let r = 2.0 * epsilon;
+        for (o, k) in chunk.iter_mut().zip(first_new + first..) {
+            let rho = reflectance(scene, samples, k);
+            // Interpolated from the old samples: indirect irradiance, and radiosity already shot.
+            let (mut wsum, mut indirect, mut shot) = (0.0, DVec3::ZERO, DVec3::ZERO);
+            if first_new > 0 {
+                shared
+                    .index
+                    .within(samples, samples.side[k], samples.uv[k], r, &mut near);
+                near.retain(|&(j, _)| (j as usize) < first_new);
+                near.sort_unstable_by_key(|&(j, _)| j);
+                shared.obstruction.retain_visible(
+                    vis,
+                    &shared.maps,
+                    samples,
+                    samples.side[k],
+                    samples.position[k],
+                    &mut near,
+                )?;
+                for &(j, d2) in &near {
+                    let j = j as usize;
+                    let w = f64::from((-alpha * d2.sqrt() / r).exp());
+                    wsum += w;
+                    indirect += w * (shared.irradiance[j] - shared.direct[j].irradiance);
+                    shot += w * (rho * shared.irradiance[j] - shared.unshot[j]);
+                }
             }
+            if wsum > 0.0 {
+                indirect /= wsum;
+                shot /= wsum;
+            }
+            let h = arrivals[k - first_new].irradiance + indirect;
+            *o = (h, rho * h - shot, emission(scene, samples, k) + rho * h);
         }
-        if wsum > 0.0 {
-            indirect /= wsum;
-            shot /= wsum;
-        }
-        let h = a.irradiance + indirect;
-        solution.direct.push(*a);
+        Ok(())
+    })?;
+    solution.direct.extend_from_slice(arrivals);
+    for (h, unshot, radiosity) in out {
         solution.irradiance.push(h);
-        solution.unshot.push(rho * h - shot);
-        solution
-            .radiosity
-            .push(emission(scene, samples, k) + rho * h);
+        solution.unshot.push(unshot);
+        solution.radiosity.push(radiosity);
     }
     debug_assert_eq!(solution.irradiance.len(), n);
     Ok(())

@@ -232,24 +232,35 @@ impl Linker<'_> {
                     // Nothing faces, or every facing pair is blocked.
                 } else if all && one_sided {
                     self.cluster_links(p, [1.0, 1.0], found, same_group);
-                } else if exhaustive {
-                    // Every member pair is known: the visible ones, sample to sample.
-                    for q in probes.iter().filter(|q| seen(q)) {
-                        leaf_links(found, q);
+                } else if all || negligible {
+                    let conditioned = self.conditioned(p.a, p.b);
+                    if !conditioned && !negligible {
+                        self.split(p.a, p.b, stack);
+                        return;
                     }
-                } else if (all || negligible) && self.conditioned(p.a, p.b) {
-                    // The formula, scaled by Σ visible exact / Σ formula over the probes.
+                    // The formula, scaled by Σ visible exact / Σ formula over the probes (pairs
+                    // facing away count 0); near grazing, where the formula is ill-conditioned,
+                    // by the visible share of the exact form factors.
                     let factor = |d: usize| {
-                        let formula: f64 = probes.iter().map(|q| q.formula[d]).sum();
                         let exact: f64 =
                             probes.iter().filter(|q| seen(q)).map(|q| q.exact[d]).sum();
-                        if formula > 0.0 {
-                            (exact / formula) as f32
+                        let whole: f64 = if conditioned {
+                            probes.iter().map(|q| q.formula[d]).sum()
+                        } else {
+                            probes.iter().map(|q| q.exact[d]).sum()
+                        };
+                        if whole > 0.0 {
+                            (exact / whole) as f32
                         } else {
                             0.0
                         }
                     };
                     self.cluster_links(p, [factor(0), factor(1)], found, same_group);
+                } else if exhaustive {
+                    // Every member pair is known: the visible ones, sample to sample.
+                    for q in probes.iter().filter(|q| seen(q)) {
+                        leaf_links(found, q);
+                    }
                 } else if !(negligible && rays == 0) {
                     self.split(p.a, p.b, stack);
                 }
