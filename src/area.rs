@@ -14,7 +14,7 @@
 use glam::{DVec3, Vec2};
 
 use crate::error::Result;
-use crate::parallel::for_chunks;
+use crate::parallel::{for_chunks, for_chunks_reporting};
 use crate::sampling::{surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::visibility::Visibility;
 
@@ -32,7 +32,7 @@ pub struct AreaStats {
 /// Computes every sample's area `S`, on up to `threads` threads (the result does not depend
 /// on their number). With `changed` (per side), only the sides it marks are recomputed: the
 /// others keep the cells and shares the last computation gave them (their samples and radii
-/// must not have changed since).
+/// must not have changed since). `report` hears the share of cells done now and then.
 #[allow(clippy::too_many_arguments)]
 pub fn compute(
     samples: &mut Samples,
@@ -43,6 +43,7 @@ pub fn compute(
     (epsilon, alpha): (f32, f32),
     threads: usize,
     changed: Option<&[bool]>,
+    report: &mut dyn FnMut(f64),
 ) -> Result<AreaStats> {
     // ε bounds the cell size where a side has only initial samples.
     let mut stats = AreaStats::default();
@@ -134,7 +135,7 @@ pub fn compute(
     };
     const CHUNK: usize = 1024;
     let mut chunks: Vec<CellShares> = vec![CellShares::default(); cells.len().div_ceil(CHUNK)];
-    for_chunks(&mut chunks, 1, threads, |c, out| {
+    let split = |c: usize, out: &mut [CellShares]| {
         let mut near = Vec::new();
         for id in c * CHUNK..((c + 1) * CHUNK).min(cells.len()) {
             if old[id].is_none() {
@@ -144,7 +145,8 @@ pub fn compute(
             }
         }
         Ok(())
-    })?;
+    };
+    for_chunks_reporting(&mut chunks, 1, threads, split, report)?;
 
     // Gather the shares by sample, in cell order within each sample (a counting sort): a sample
     // on a kept side keeps its shares (their cells renumbered), the others take the new ones.

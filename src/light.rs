@@ -13,7 +13,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use crate::error::Result;
-use crate::parallel::for_chunks;
+use crate::parallel::for_chunks_reporting;
 use crate::sampling::poisson::side_seed;
 use crate::scene::Scene;
 use crate::visibility::{Segment, Visibility};
@@ -100,6 +100,7 @@ impl DirectLight {
 
     /// Direct light at each (position, normal); receiver i draws its shadow rays from a seed
     /// derived from (`seed`, `ids[i]`), so answers do not depend on batching or threads.
+    /// `report` hears the share done now and then.
     pub fn at(
         &self,
         vis: &dyn Visibility,
@@ -107,10 +108,11 @@ impl DirectLight {
         ids: &[u32],
         seed: u64,
         threads: usize,
+        report: &mut dyn FnMut(f64),
     ) -> Result<(Vec<Arrival>, u64)> {
         let mut out = vec![Arrival::default(); points.len()];
         let queries = std::sync::atomic::AtomicU64::new(0);
-        for_chunks(&mut out, 256, threads, |first, chunk| {
+        let work = |first: usize, chunk: &mut [Arrival]| {
             let n = self.batch(
                 vis,
                 &points[first..first + chunk.len()],
@@ -120,7 +122,8 @@ impl DirectLight {
             )?;
             queries.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
             Ok(())
-        })?;
+        };
+        for_chunks_reporting(&mut out, 256, threads, work, report)?;
         Ok((out, queries.into_inner()))
     }
 

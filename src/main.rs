@@ -22,12 +22,19 @@ struct Args {
 struct SolveArgs {
     /// The scene file (TOML).
     scene: PathBuf,
-    /// Start from a preset: preview, default or final.
-    #[arg(long, default_value = "default")]
-    preset: String,
     /// Poisson-disk spacing ε of the initial samples (default: the scene file's, else automatic).
     #[arg(long)]
     epsilon: Option<f32>,
+    #[command(flatten)]
+    knobs: Knobs,
+}
+
+/// Every solver setting but the scene and ε.
+#[derive(clap::Args)]
+struct Knobs {
+    /// Start from a preset: preview, default or final.
+    #[arg(long, default_value = "default")]
+    preset: String,
     /// Adaptive error threshold ζ, relative to the mean radiosity.
     #[arg(long)]
     zeta: Option<f32>,
@@ -91,6 +98,22 @@ enum Command {
         #[arg(short, long, default_value = "samples.ply")]
         output: PathBuf,
     },
+    /// Measure how the solver scales: solve at several ε with the cluster hierarchy and (where
+    /// it fits in the time limit) the flat solver, print samples, links, queries, seconds per
+    /// phase and peak memory, and the exponents of time and queries against the samples.
+    Scale {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// The spacings to solve at, comma-separated, largest first (e.g. 0.6,0.3,0.15).
+        #[arg(long, value_delimiter = ',', required = true)]
+        epsilon: Vec<f32>,
+        /// Skip a flat solve predicted (from the previous one, as N²) to take longer than this
+        /// many seconds.
+        #[arg(long, default_value_t = 600.0)]
+        flat_limit: f64,
+        #[command(flatten)]
+        knobs: Knobs,
+    },
     /// Print a summary of a scene: geometry, surfaces, lights, camera.
     Info {
         /// The scene file (TOML).
@@ -146,7 +169,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             supersample,
         } => {
             let started = std::time::Instant::now();
-            let (scene, options) = cli::solve_setup(&solve)?;
+            let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
             let vis = options.backend.build(&scene)?;
             let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
             let render_options = meshlight::RenderOptions {
@@ -163,8 +186,12 @@ fn run(args: Args) -> anyhow::Result<()> {
             print!("{}", cli::solve_summary(&scene, &solution, &options));
             print!("{}", cli::render_summary(&image, &stats, render_seconds));
             println!(
-                "total {:.2} s; wrote {} and {}",
+                "total {:.2} s{}; wrote {} and {}",
                 started.elapsed().as_secs_f64(),
+                cli::memory::peak_bytes().map_or(String::new(), |b| format!(
+                    ", peak memory {}",
+                    cli::memory::human(b)
+                )),
                 output.display(),
                 png.display()
             );
@@ -187,7 +214,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             );
         }
         Command::Samples { solve, output } => {
-            let (scene, options) = cli::solve_setup(&solve)?;
+            let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
             let vis = options.backend.build(&scene)?;
             let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
             let mean = solution
@@ -205,6 +232,16 @@ fn run(args: Args) -> anyhow::Result<()> {
                 output.display(),
                 solution.samples.len()
             );
+        }
+        Command::Scale {
+            scene,
+            epsilon,
+            flat_limit,
+            knobs,
+        } => {
+            let (scene, options) = cli::solve_setup(&scene, None, &knobs)?;
+            let vis = options.backend.build(&scene)?;
+            cli::scale::run(&scene, vis.as_ref(), &options, &epsilon, flat_limit)?;
         }
         Command::Info { scene } => {
             let scene = load(&scene)?;

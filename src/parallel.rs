@@ -49,3 +49,57 @@ pub(crate) fn for_chunks<T: Send>(
         None => Ok(()),
     }
 }
+
+/// How a long parallel job tells its caller how far it has got: the share done, in [0, 1],
+/// called on the calling thread between parts of the work.
+pub(crate) type Report<'a> = &'a mut dyn FnMut(f64);
+
+/// [`for_chunks`] in about `PARTS` parts, with `report` after each. Part boundaries fall on chunk
+/// boundaries, so the chunks and their results are the same as one call's.
+pub(crate) fn for_chunks_reporting<T: Send>(
+    out: &mut [T],
+    chunk: usize,
+    threads: usize,
+    f: impl Fn(usize, &mut [T]) -> Result<()> + Sync,
+    report: Report,
+) -> Result<()> {
+    const PARTS: usize = 20;
+    let chunk = chunk.max(1);
+    let total = out.len();
+    let part = total.div_ceil(PARTS).div_ceil(chunk).max(1) * chunk;
+    let mut done = 0;
+    for piece in out.chunks_mut(part) {
+        let len = piece.len();
+        for_chunks(piece, chunk, threads, |i, c| f(done + i, c))?;
+        done += len;
+        report(done as f64 / total.max(1) as f64);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reporting_in_parts_gives_the_same_chunks_and_counts_up_to_one() {
+        let f = |first: usize, c: &mut [u64]| {
+            // Each chunk's value depends on its first index and length only.
+            let len = c.len();
+            for (i, x) in c.iter_mut().enumerate() {
+                *x = (first * 1000 + len * 10 + i) as u64;
+            }
+            Ok(())
+        };
+        for threads in [1, 2] {
+            let (mut a, mut b) = (vec![0u64; 10_007], vec![0u64; 10_007]);
+            for_chunks(&mut a, 64, threads, f).unwrap();
+            let mut reports = Vec::new();
+            for_chunks_reporting(&mut b, 64, threads, f, &mut |x| reports.push(x)).unwrap();
+            assert_eq!(a, b);
+            assert!(reports.windows(2).all(|w| w[0] < w[1]), "{reports:?}");
+            assert_eq!(reports.last(), Some(&1.0));
+            assert!(reports.len() >= 10, "{}", reports.len());
+        }
+    }
+}

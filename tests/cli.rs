@@ -99,6 +99,7 @@ fn gallery_generator_writes_a_loadable_reduced_gallery() {
         meshlight_gallery::GalleryOptions {
             tile: 0.5,
             sphere_detail: 0,
+            ..Default::default()
         },
     )
     .unwrap();

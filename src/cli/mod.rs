@@ -1,5 +1,8 @@
 //! What the CLI prints: text renderings of the library's reports.
 
+pub mod memory;
+pub mod scale;
+
 use std::fmt::Write;
 use std::time::Duration;
 
@@ -271,15 +274,19 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
 }
 
 /// Options from a preset, the scene file and the command line, in that order of precedence.
-pub fn solve_setup(args: &crate::SolveArgs) -> anyhow::Result<(Scene, Options)> {
-    let scene = crate::load(&args.scene)?;
+pub fn solve_setup(
+    scene: &std::path::Path,
+    epsilon: Option<f32>,
+    args: &crate::Knobs,
+) -> anyhow::Result<(Scene, Options)> {
+    let scene = crate::load(scene)?;
     let mut o = match args.preset.as_str() {
         "preview" => Options::preview(),
         "default" => Options::default(),
         "final" => Options::final_quality(),
         other => anyhow::bail!("unknown --preset '{other}' (known: preview, default, final)"),
     };
-    o.epsilon = args.epsilon.or(o.epsilon);
+    o.epsilon = epsilon.or(o.epsilon);
     o.zeta = args.zeta.unwrap_or(o.zeta);
     o.alpha = args.alpha.unwrap_or(o.alpha);
     o.rounds = args.rounds.unwrap_or(o.rounds);
@@ -294,7 +301,8 @@ pub fn solve_setup(args: &crate::SolveArgs) -> anyhow::Result<(Scene, Options)> 
     Ok((scene, o))
 }
 
-/// Solves with a progress line on stderr.
+/// Solves with a progress line on stderr: the phase, how far it has got, and an estimate of
+/// the time it still needs.
 pub fn solve_with_progress(
     scene: &Scene,
     vis: &dyn Visibility,
@@ -312,37 +320,63 @@ pub fn solve_with_progress(
         ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}").expect("valid template"),
     );
     bar.enable_steady_tick(Duration::from_millis(200));
+    let mut phase = Eta::default();
     let solution = meshlight::solve(scene, vis, options, &mut |p: &Progress| {
-        bar.set_message(progress_line(p));
+        bar.set_message(progress_line(p, phase.update(p)));
         Control::Continue
     });
     bar.finish_and_clear();
     Ok(solution?)
 }
 
-fn progress_line(p: &Progress) -> String {
+/// Time left in the current phase, from how long it has run and the share done.
+#[derive(Default)]
+struct Eta {
+    current: Option<(Phase, u32, std::time::Instant)>,
+}
+
+impl Eta {
+    fn update(&mut self, p: &Progress) -> Option<Duration> {
+        let now = std::time::Instant::now();
+        match self.current {
+            Some((phase, round, _)) if phase == p.phase && round == p.round => {}
+            _ => self.current = Some((p.phase, p.round, now)),
+        }
+        let (_, _, start) = self.current?;
+        let f = p.fraction;
+        (f > 0.02 && f < 1.0)
+            .then(|| Duration::from_secs_f64(start.elapsed().as_secs_f64() * (1.0 - f) / f))
+    }
+}
+
+fn progress_line(p: &Progress, eta: Option<Duration>) -> String {
     let phase = match p.phase {
         Phase::Sampling => "placing samples",
         Phase::Areas => "representative areas",
         Phase::DirectLight => "direct light",
+        Phase::Links => "links and row sums",
         Phase::Shooting => "shooting",
         Phase::Adaptive => "adding samples",
         _ => "working",
     };
+    let done = if p.fraction > 0.0 {
+        format!(", {:.0}%", 100.0 * p.fraction)
+    } else {
+        String::new()
+    };
+    let left = eta.map_or(String::new(), |d| {
+        format!(", about {:.0} s left", d.as_secs_f64().ceil())
+    });
     if p.phase == Phase::Shooting {
-        // Progress towards the tolerance on a log scale.
-        let done = (p.unshot_fraction.max(1e-300).ln() / p.tolerance.ln()).clamp(0.0, 1.0);
         format!(
-            "round {}: {phase}: {} samples, {} shots, unshot {:.2e} of emitted (target {:.0e}), {:.0}%",
-            p.round,
-            p.samples,
-            p.shots,
-            p.unshot_fraction,
-            p.tolerance,
-            100.0 * done
+            "round {}: {phase}: {} samples, {} shots, unshot {:.2e} of emitted (target {:.0e}){done}{left}",
+            p.round, p.samples, p.shots, p.unshot_fraction, p.tolerance
         )
     } else {
-        format!("round {}: {phase}: {} samples", p.round, p.samples)
+        format!(
+            "round {}: {phase}: {} samples{done}{left}",
+            p.round, p.samples
+        )
     }
 }
 
@@ -423,6 +457,17 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
             "warning: the solve diverged: its unshot power grew; the image is not to be trusted"
         );
     }
+    let bytes: u64 = s.rounds.iter().map(|r| r.shooting.bytes).max().unwrap_or(0);
+    let _ = writeln!(
+        out,
+        "solver: {}; links and caches held at most {}",
+        if o.cluster_threshold > 0.0 {
+            format!("cluster hierarchy, threshold {}", o.cluster_threshold)
+        } else {
+            "flat (every sample to every sample)".into()
+        },
+        memory::human(bytes),
+    );
     if s.stop() == StopReason::ShotLimit {
         let _ = writeln!(
             out,

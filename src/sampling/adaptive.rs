@@ -18,7 +18,7 @@ use rand_pcg::Pcg64Mcg;
 use super::poisson::side_seed;
 use super::{surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::error::Result;
-use crate::parallel::for_chunks;
+use crate::parallel::{for_chunks, for_chunks_reporting};
 use crate::visibility::Visibility;
 
 /// Radii stop shrinking at ε / MAX_SPLIT.
@@ -63,6 +63,7 @@ pub struct RefineSettings {
 
 /// Eq. 7's error of every sample, relative to the mean luminance of `radiosity`; NaN where a
 /// sample has no neighbour within 2D that it sees along its side. On up to `threads` threads.
+#[allow(clippy::too_many_arguments)]
 pub fn errors(
     samples: &Samples,
     maps: &[SurfaceMap],
@@ -71,11 +72,12 @@ pub fn errors(
     vis: &dyn Visibility,
     radiosity: &[DVec3],
     threads: usize,
+    report: &mut dyn FnMut(f64),
 ) -> Result<Vec<f64>> {
     let n = samples.len();
     let mean = radiosity.iter().map(|&b| luminance(b)).sum::<f64>() / n.max(1) as f64;
     let mut out = vec![0.0; n];
-    for_chunks(&mut out, 1024, threads, |first, chunk| {
+    let error = |first: usize, chunk: &mut [f64]| {
         let mut near = Vec::new();
         for (e, k) in chunk.iter_mut().zip(first..) {
             let (side, uv, d) = (samples.side[k], samples.uv[k], samples.radius[k]);
@@ -96,12 +98,15 @@ pub fn errors(
             };
         }
         Ok(())
-    })?;
+    };
+    for_chunks_reporting(&mut out, 1024, threads, error, report)?;
     Ok(out)
 }
 
 /// Refines where the error exceeds ζ: shrinks those samples' radii and adds new samples
 /// around them (appended to `samples`, area 0). The index must describe `samples` as given.
+/// `report` hears the share of the errors computed now and then.
+#[allow(clippy::too_many_arguments)]
 pub fn refine(
     samples: &mut Samples,
     maps: &[SurfaceMap],
@@ -110,6 +115,7 @@ pub fn refine(
     vis: &dyn Visibility,
     radiosity: &[DVec3],
     settings: RefineSettings,
+    report: &mut dyn FnMut(f64),
 ) -> Result<Refinement> {
     let errors = errors(
         samples,
@@ -119,6 +125,7 @@ pub fn refine(
         vis,
         radiosity,
         settings.threads,
+        report,
     )?;
     let mut result = Refinement::default();
     let eps = settings.epsilon;

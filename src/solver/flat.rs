@@ -219,7 +219,12 @@ pub(crate) fn shoot(
                 break;
             }
             if stats.shots % 32 == 0
-                && report(Tick::shooting(stats.shots, stats.unshot_fraction)) == Control::Stop
+                && report(Tick::shooting(
+                    stats.shots,
+                    stats.unshot_fraction,
+                    stats.initial_unshot_fraction,
+                    settings.tolerance,
+                )) == Control::Stop
             {
                 stats.stop = StopReason::Stopped;
                 break;

@@ -232,6 +232,28 @@ pub fn solve(
     Ok(solution)
 }
 
+/// A reporter for a phase of a round: hears the share done, tells the host (stopping is
+/// honoured at shots and round boundaries only).
+fn reporter<'a>(
+    progress: &'a mut dyn FnMut(&Progress) -> Control,
+    phase: Phase,
+    round: u32,
+    samples: usize,
+    tolerance: f64,
+) -> impl FnMut(f64) + 'a {
+    move |fraction| {
+        let _ = progress(&Progress {
+            phase,
+            round,
+            samples,
+            shots: 0,
+            unshot_fraction: 1.0,
+            tolerance,
+            fraction,
+        });
+    }
+}
+
 /// What one solve holds across its rounds.
 struct Solve<'a> {
     scene: &'a Scene,
@@ -326,6 +348,13 @@ impl Solve<'_> {
             (self.epsilon, options.alpha),
             threads,
             added.changed.as_deref(),
+            &mut reporter(
+                &mut *self.progress,
+                Phase::Areas,
+                round,
+                n,
+                options.tolerance,
+            ),
         )?;
         seconds.areas = t.elapsed().as_secs_f64();
 
@@ -337,8 +366,20 @@ impl Solve<'_> {
             .map(|k| (s.position[k], s.normal[k]))
             .collect();
         let ids: Vec<u32> = (first_new as u32..n as u32).collect();
-        let (arrivals, direct_queries) =
-            self.light.at(vis, &points, &ids, options.seed, threads)?;
+        let (arrivals, direct_queries) = self.light.at(
+            vis,
+            &points,
+            &ids,
+            options.seed,
+            threads,
+            &mut reporter(
+                &mut *self.progress,
+                Phase::DirectLight,
+                round,
+                n,
+                options.tolerance,
+            ),
+        )?;
         seconds.direct = t.elapsed().as_secs_f64();
         warm::start(
             scene,
@@ -373,6 +414,13 @@ impl Solve<'_> {
             vis,
             (options.seed, threads),
             self.lift,
+            &mut reporter(
+                &mut *self.progress,
+                Phase::Links,
+                round,
+                n,
+                options.tolerance,
+            ),
         )?;
         solution.closed.extend(probes);
         let hierarchical = self.grid.is_some();
@@ -485,6 +533,7 @@ impl Solve<'_> {
             return Ok(None);
         }
         let options = self.options;
+        let n = solution.samples.len();
         let radii = solution.samples.radius.clone();
         let refinement = adaptive::refine(
             &mut solution.samples,
@@ -502,6 +551,13 @@ impl Solve<'_> {
                 seed: options.seed,
                 max_samples: options.max_samples,
             },
+            &mut reporter(
+                &mut *self.progress,
+                Phase::Adaptive,
+                round,
+                n,
+                options.tolerance,
+            ),
         )?;
         let samples = &solution.samples;
         let mut changed = vec![false; 2 * solution.maps.len()];

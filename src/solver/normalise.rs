@@ -7,7 +7,7 @@
 use rand::{RngExt, SeedableRng};
 
 use crate::error::Result;
-use crate::parallel::for_chunks;
+use crate::parallel::{for_chunks_reporting, Report};
 use crate::sampling::{poisson, Samples};
 use crate::scene::Scene;
 use crate::visibility::{Ray, Visibility};
@@ -35,6 +35,7 @@ pub(crate) fn row_scale(sum: f64, closed: bool) -> f32 {
 /// back of a light, say), leaves the row unnormalised. Rays, not segments: a segment ignores
 /// hits near its ends, which lets a probe from a sample beside an edge slip past the
 /// neighbouring face.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn closed_hemispheres(
     scene: &Scene,
     reflecting: &[bool],
@@ -43,10 +44,11 @@ pub(crate) fn closed_hemispheres(
     vis: &dyn Visibility,
     (seed, threads): (u64, usize),
     lift: f32,
+    report: Report,
 ) -> Result<Vec<bool>> {
     let diagonal = scene.bounds.diagonal();
     let mut out = vec![true; samples.len() - first];
-    for_chunks(&mut out, 128, threads, |start, chunk| {
+    let probe = |start: usize, chunk: &mut [bool]| {
         let mut rays = Vec::with_capacity(chunk.len() * PROBES as usize);
         for k in first + start..first + start + chunk.len() {
             let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(poisson::side_seed(seed, k as u32, 11));
@@ -84,6 +86,7 @@ pub(crate) fn closed_hemispheres(
             });
         }
         Ok(())
-    })?;
+    };
+    for_chunks_reporting(&mut out, 128, threads, probe, report)?;
     Ok(out)
 }

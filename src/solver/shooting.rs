@@ -67,13 +67,21 @@ impl Tick {
         }
     }
 
-    /// Shooting, after `shots` shots with `unshot_fraction` of the emitted power left.
-    pub fn shooting(shots: u64, unshot_fraction: f64) -> Tick {
+    /// Shooting, after `shots` shots with `unshot_fraction` of the emitted power left, from
+    /// `initial` at the start towards `tolerance`: the share done is the share of the way on a
+    /// log scale (unshot power falls about geometrically).
+    pub fn shooting(shots: u64, unshot_fraction: f64, initial: f64, tolerance: f64) -> Tick {
+        let way = (initial / tolerance).ln();
+        let fraction = if way > 0.0 && unshot_fraction > 0.0 {
+            ((initial / unshot_fraction).ln() / way).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         Tick {
             phase: Phase::Shooting,
             shots,
             unshot_fraction,
-            fraction: 0.0,
+            fraction,
         }
     }
 }

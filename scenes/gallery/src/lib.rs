@@ -1,9 +1,11 @@
-//! Writes meshlight's gallery scene as OBJ: four 12 m × 7.9 m rooms under one 4.5 m ceiling,
-//! joined by doorways in solid partition walls 0.2 m thick, with pedestals carrying faceted
-//! sculptures, framed paintings on the outer walls, benches, and 8 point lights under the
-//! ceiling (in `scene.toml`). Floors and outer walls are tiled (`tile`, default 0.1 m), as
-//! architectural exports often are, which gives ≥ 100k triangles mixing huge ceiling triangles
-//! with small ones. The OBJ is generated rather than committed (several MB).
+//! Writes meshlight's gallery scene as OBJ: a grid of rooms (2 × 2 by default: four 12 m × 7.9 m
+//! rooms) under one 4.5 m ceiling, joined by doorways in solid partition walls 0.2 m thick, with
+//! pedestals carrying faceted sculptures, framed paintings on the outer walls, benches, and two
+//! point lights per room under the ceiling (in `scene.toml`). Floors and outer walls are tiled
+//! (`tile`, default 0.1 m), as architectural exports often are, which gives ≥ 100k triangles per
+//! four rooms, mixing huge ceiling triangles with small ones. The OBJ is generated rather than
+//! committed (several MB). Larger grids (`rooms`) go to a folder of their own, with a
+//! `scene.toml` written for them.
 //!
 //! Every solid (partition walls, pedestals, frames, benches, sculptures) faces outwards; the
 //! rooms' floor, ceiling and outer walls face inwards. No faces hide inside solids: tiles under
@@ -22,6 +24,8 @@ pub struct GalleryOptions {
     pub tile: f64,
     /// Subdivision level of the icosphere sculptures (0 = icosahedron).
     pub sphere_detail: u32,
+    /// Rooms along x and along z (each 12 m × 8 m between partition centres).
+    pub rooms: [usize; 2],
 }
 
 impl Default for GalleryOptions {
@@ -29,18 +33,84 @@ impl Default for GalleryOptions {
         GalleryOptions {
             tile: 0.1,
             sphere_detail: 2,
+            rooms: [2, 2],
         }
     }
 }
 
-/// Building size, metres.
-const WIDTH: f64 = 24.0;
-const DEPTH: f64 = 16.0;
+/// A room's size between partition centres, metres.
+const ROOM_X: f64 = 12.0;
+const ROOM_Z: f64 = 8.0;
 const HEIGHT: f64 = 4.5;
-/// Partition walls: one along x at z = 8, one along z at x = 12.
+/// Partition walls: along x at z = 8, 16, ..., along z at x = 12, 24, ...
 const WALL: f64 = 0.2;
 const DOOR_WIDTH: f64 = 1.6;
 const DOOR_HEIGHT: f64 = 2.6;
+
+/// The grid of rooms.
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    nx: usize,
+    nz: usize,
+}
+
+impl Layout {
+    fn width(&self) -> f64 {
+        ROOM_X * self.nx as f64
+    }
+
+    fn depth(&self) -> f64 {
+        ROOM_Z * self.nz as f64
+    }
+
+    /// Room (i, j)'s floor between partition faces: (x0, x1, z0, z1).
+    fn room(&self, i: usize, j: usize) -> (f64, f64, f64, f64) {
+        let half = WALL / 2.0;
+        let x0 = ROOM_X * i as f64 + if i > 0 { half } else { 0.0 };
+        let x1 = ROOM_X * (i + 1) as f64 - if i + 1 < self.nx { half } else { 0.0 };
+        let z0 = ROOM_Z * j as f64 + if j > 0 { half } else { 0.0 };
+        let z1 = ROOM_Z * (j + 1) as f64 - if j + 1 < self.nz { half } else { 0.0 };
+        (x0, x1, z0, z1)
+    }
+
+    /// The doorway (x range) of the wall along x at z = 8j, in room column i.
+    fn door_x(&self, i: usize, j: usize) -> (f64, f64) {
+        let a = ROOM_X * i as f64 + 5.0 + if (i + j + 1) % 2 == 1 { 0.4 } else { 0.0 };
+        (a, a + DOOR_WIDTH)
+    }
+
+    /// The doorway (z range) of the wall along z at x = 12i, in room row j.
+    fn door_z(&self, j: usize) -> (f64, f64) {
+        let a = ROOM_Z * j as f64 + 3.2;
+        (a, a + DOOR_WIDTH)
+    }
+
+    /// Whether a point lies within a partition wall's footprint (doorways included).
+    fn in_partition(&self, x: f64, z: f64) -> bool {
+        let near =
+            |v: f64, step: f64, n: usize| (1..n).any(|k| (v - step * k as f64).abs() < WALL / 2.0);
+        near(x, ROOM_X, self.nx) || near(z, ROOM_Z, self.nz)
+    }
+
+    /// Whether floor point (x, z) lies under a partition wall (outside the doorways).
+    fn under_wall(&self, x: f64, z: f64) -> bool {
+        let column = ((x / ROOM_X).floor() as usize).min(self.nx - 1);
+        let row = ((z / ROOM_Z).floor() as usize).min(self.nz - 1);
+        let in_a = (1..self.nz).any(|j| {
+            (z - ROOM_Z * j as f64).abs() < WALL / 2.0 && {
+                let (a, b) = self.door_x(column, j);
+                !(x > a && x < b)
+            }
+        });
+        let in_b = (1..self.nx).any(|i| {
+            (x - ROOM_X * i as f64).abs() < WALL / 2.0 && {
+                let (a, b) = self.door_z(row);
+                !(z > a && z < b)
+            }
+        });
+        in_a || in_b
+    }
+}
 
 /// What was written.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -147,20 +217,6 @@ fn scale(a: P, s: f64) -> P {
 }
 fn normalize(a: P) -> P {
     scale(a, 1.0 / dot(a, a).sqrt())
-}
-
-/// The two partition walls as footprints: (x0, x1, z0, z1).
-const WALL_A: (f64, f64, f64, f64) = (0.0, WIDTH, 8.0 - WALL / 2.0, 8.0 + WALL / 2.0);
-const WALL_B: (f64, f64, f64, f64) = (12.0 - WALL / 2.0, 12.0 + WALL / 2.0, 0.0, DEPTH);
-/// Doorways: in wall A (ranges of x) and in wall B (ranges of z).
-const DOORS_A: [(f64, f64); 2] = [(5.0, 5.0 + DOOR_WIDTH), (17.4, 17.4 + DOOR_WIDTH)];
-const DOORS_B: [(f64, f64); 2] = [(3.2, 3.2 + DOOR_WIDTH), (11.2, 11.2 + DOOR_WIDTH)];
-
-/// Whether floor point (x, z) lies under a partition wall (outside the doorways).
-fn under_wall(x: f64, z: f64) -> bool {
-    let in_a = z > WALL_A.2 && z < WALL_A.3 && !DOORS_A.iter().any(|&(a, b)| x > a && x < b);
-    let in_b = x > WALL_B.0 && x < WALL_B.1 && !DOORS_B.iter().any(|&(a, b)| z > a && z < b);
-    in_a || in_b
 }
 
 /// One straight partition-wall segment: from `start` along unit axis `along` for `length`,
@@ -340,16 +396,21 @@ fn painting(obj: &mut Obj, canvas: &str, origin: P, right: P, normal: P, w: f64,
 fn build(options: GalleryOptions) -> Obj {
     let mut obj = Obj::default();
     let tile = options.tile;
+    let layout = Layout {
+        nx: options.rooms[0].max(1),
+        nz: options.rooms[1].max(1),
+    };
+    let (width, depth) = (layout.width(), layout.depth());
 
     // Floor: tiles, none under the partition walls (doorways keep theirs).
     let (nx, nz) = (
-        (WIDTH / tile).round() as usize,
-        (DEPTH / tile).round() as usize,
+        (width / tile).round() as usize,
+        (depth / tile).round() as usize,
     );
     for i in 0..nx {
         for k in 0..nz {
             let (x, z) = (i as f64 * tile, k as f64 * tile);
-            if !under_wall(x + tile / 2.0, z + tile / 2.0) {
+            if !layout.under_wall(x + tile / 2.0, z + tile / 2.0) {
                 obj.rect(
                     "floor",
                     [x, 0.0, z],
@@ -361,8 +422,9 @@ fn build(options: GalleryOptions) -> Obj {
         }
     }
     // Ceiling: one large quad per room (huge triangles beside the small ones).
-    for (x0, x1) in [(0.0, WALL_B.0), (WALL_B.1, WIDTH)] {
-        for (z0, z1) in [(0.0, WALL_A.2), (WALL_A.3, DEPTH)] {
+    for i in 0..layout.nx {
+        for j in 0..layout.nz {
+            let (x0, x1, z0, z1) = layout.room(i, j);
             obj.rect(
                 "ceiling",
                 [x0, HEIGHT, z0],
@@ -375,19 +437,17 @@ fn build(options: GalleryOptions) -> Obj {
     // Outer walls, tiled, facing in; no tiles behind the partition walls' ends.
     let ny = (HEIGHT / tile).round() as usize;
     let walls: [(P, P, f64, P); 4] = [
-        ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], WIDTH, [0.0, 0.0, 1.0]),
-        ([0.0, 0.0, DEPTH], [1.0, 0.0, 0.0], WIDTH, [0.0, 0.0, -1.0]),
-        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], DEPTH, [1.0, 0.0, 0.0]),
-        ([WIDTH, 0.0, 0.0], [0.0, 0.0, 1.0], DEPTH, [-1.0, 0.0, 0.0]),
+        ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], width, [0.0, 0.0, 1.0]),
+        ([0.0, 0.0, depth], [1.0, 0.0, 0.0], width, [0.0, 0.0, -1.0]),
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], depth, [1.0, 0.0, 0.0]),
+        ([width, 0.0, 0.0], [0.0, 0.0, 1.0], depth, [-1.0, 0.0, 0.0]),
     ];
     for (origin, along, length, normal) in walls {
         let n = (length / tile).round() as usize;
         for i in 0..n {
             let u = (i as f64 + 0.5) * tile;
             let mid = add(origin, scale(along, u));
-            let behind_partition = (mid[0] > WALL_B.0 && mid[0] < WALL_B.1)
-                || (mid[2] > WALL_A.2 && mid[2] < WALL_A.3);
-            if behind_partition {
+            if layout.in_partition(mid[0], mid[2]) {
                 continue;
             }
             for j in 0..ny {
@@ -399,122 +459,163 @@ fn build(options: GalleryOptions) -> Obj {
             }
         }
     }
-    // Partition walls: A along x in two segments around the junction, B along z likewise.
-    let (a_z, b_x) = (8.0, 12.0);
-    let shift = |doors: [(f64, f64); 2], by: f64| doors.map(|(a, b)| (a - by, b - by));
-    partition(
-        &mut obj,
-        [0.0, 0.0, a_z],
-        [1.0, 0.0, 0.0],
-        WALL_B.0,
-        [0.0, 0.0, 1.0],
-        &DOORS_A[..1],
-    );
-    partition(
-        &mut obj,
-        [WALL_B.1, 0.0, a_z],
-        [1.0, 0.0, 0.0],
-        WIDTH - WALL_B.1,
-        [0.0, 0.0, 1.0],
-        &shift(DOORS_A, WALL_B.1)[1..],
-    );
-    partition(
-        &mut obj,
-        [b_x, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-        WALL_A.2,
-        [1.0, 0.0, 0.0],
-        &DOORS_B[..1],
-    );
-    partition(
-        &mut obj,
-        [b_x, 0.0, WALL_A.3],
-        [0.0, 0.0, 1.0],
-        DEPTH - WALL_A.3,
-        [1.0, 0.0, 0.0],
-        &shift(DOORS_B, WALL_A.3)[1..],
-    );
+    // Partition walls, one segment per room they bound, each with its doorway: along x at
+    // z = 8j, along z at x = 12i.
+    for j in 1..layout.nz {
+        for i in 0..layout.nx {
+            let (x0, x1, _, _) = layout.room(i, j);
+            let (a, b) = layout.door_x(i, j);
+            partition(
+                &mut obj,
+                [x0, 0.0, ROOM_Z * j as f64],
+                [1.0, 0.0, 0.0],
+                x1 - x0,
+                [0.0, 0.0, 1.0],
+                &[(a - x0, b - x0)],
+            );
+        }
+    }
+    for i in 1..layout.nx {
+        for j in 0..layout.nz {
+            let (_, _, z0, z1) = layout.room(i, j);
+            let (a, b) = layout.door_z(j);
+            partition(
+                &mut obj,
+                [ROOM_X * i as f64, 0.0, z0],
+                [0.0, 0.0, 1.0],
+                z1 - z0,
+                [1.0, 0.0, 0.0],
+                &[(a - z0, b - z0)],
+            );
+        }
+    }
 
-    // Per room: two pedestals with sculptures, a bench, paintings on its two outer walls.
+    // Per room: two pedestals with sculptures, a bench, paintings on its outer walls.
     let canvases = ["canvas_red", "canvas_blue", "canvas_ochre", "canvas_teal"];
-    let rooms = [
-        (0.0, 0.0),
-        (WALL_B.1, 0.0),
-        (0.0, WALL_A.3),
-        (WALL_B.1, WALL_A.3),
-    ];
-    for (r, &(rx, rz)) in rooms.iter().enumerate() {
-        let (w, d) = (WALL_B.0, WALL_A.2);
-        for (p, &(fx, fz)) in [(0.3, 0.35), (0.7, 0.65)].iter().enumerate() {
-            let (cx, cz) = (rx + fx * w, rz + fz * d);
+    for j in 0..layout.nz {
+        for i in 0..layout.nx {
+            let r = j * layout.nx + i;
+            let (rx, x1, rz, z1) = layout.room(i, j);
+            let (w, d) = (x1 - rx, z1 - rz);
+            for (p, &(fx, fz)) in [(0.3, 0.35), (0.7, 0.65)].iter().enumerate() {
+                let (cx, cz) = (rx + fx * w, rz + fz * d);
+                block(
+                    &mut obj,
+                    "pedestal",
+                    [cx - 0.3, 0.0, cz - 0.3],
+                    [cx + 0.3, 1.0, cz + 0.3],
+                    false,
+                );
+                let detail = if p == 0 {
+                    options.sphere_detail
+                } else {
+                    options.sphere_detail.saturating_sub(1)
+                };
+                icosphere(&mut obj, "stone", [cx, 1.0 + 0.32, cz], 0.32, detail);
+            }
+            let (bx, bz) = (rx + 0.5 * w, rz + 0.5 * d);
             block(
                 &mut obj,
-                "pedestal",
-                [cx - 0.3, 0.0, cz - 0.3],
-                [cx + 0.3, 1.0, cz + 0.3],
+                "bench",
+                [bx - 0.8, 0.0, bz - 0.2],
+                [bx + 0.8, 0.45, bz + 0.2],
                 false,
             );
-            let detail = if p == 0 {
-                options.sphere_detail
-            } else {
-                options.sphere_detail.saturating_sub(1)
+            // The room's outer walls, if it has any: z = 0 or the depth, x = 0 or the width.
+            let z_wall = match j {
+                0 => Some((0.0, [0.0, 0.0, 1.0])),
+                _ if j + 1 == layout.nz => Some((depth, [0.0, 0.0, -1.0])),
+                _ => None,
             };
-            icosphere(&mut obj, "stone", [cx, 1.0 + 0.32, cz], 0.32, detail);
-        }
-        let (bx, bz) = (rx + 0.5 * w, rz + 0.5 * d);
-        block(
-            &mut obj,
-            "bench",
-            [bx - 0.8, 0.0, bz - 0.2],
-            [bx + 0.8, 0.45, bz + 0.2],
-            false,
-        );
-        // The room's outer walls: z = 0 or DEPTH, and x = 0 or WIDTH.
-        let z_wall = if rz == 0.0 {
-            (0.0, [0.0, 0.0, 1.0])
-        } else {
-            (DEPTH, [0.0, 0.0, -1.0])
-        };
-        let x_wall = if rx == 0.0 {
-            (0.0, [1.0, 0.0, 0.0])
-        } else {
-            (WIDTH, [-1.0, 0.0, 0.0])
-        };
-        for i in 0..3 {
-            let canvas = canvases[(r + i) % canvases.len()];
-            let x = rx + 1.8 + i as f64 * 3.4;
-            painting(
-                &mut obj,
-                canvas,
-                [x, 1.3, z_wall.0],
-                [1.0, 0.0, 0.0],
-                z_wall.1,
-                1.6,
-                1.1,
-            );
-        }
-        for i in 0..2 {
-            let canvas = canvases[(r + i + 1) % canvases.len()];
-            let z = rz + 1.6 + i as f64 * 3.2;
-            painting(
-                &mut obj,
-                canvas,
-                [x_wall.0, 1.3, z],
-                [0.0, 0.0, 1.0],
-                x_wall.1,
-                1.4,
-                1.0,
-            );
+            let x_wall = match i {
+                0 => Some((0.0, [1.0, 0.0, 0.0])),
+                _ if i + 1 == layout.nx => Some((width, [-1.0, 0.0, 0.0])),
+                _ => None,
+            };
+            if let Some((z, normal)) = z_wall {
+                for k in 0..3 {
+                    let canvas = canvases[(r + k) % canvases.len()];
+                    let x = rx + 1.8 + k as f64 * 3.4;
+                    painting(
+                        &mut obj,
+                        canvas,
+                        [x, 1.3, z],
+                        [1.0, 0.0, 0.0],
+                        normal,
+                        1.6,
+                        1.1,
+                    );
+                }
+            }
+            if let Some((x, normal)) = x_wall {
+                for k in 0..2 {
+                    let canvas = canvases[(r + k + 1) % canvases.len()];
+                    let z = rz + 1.6 + k as f64 * 3.2;
+                    painting(
+                        &mut obj,
+                        canvas,
+                        [x, 1.3, z],
+                        [0.0, 0.0, 1.0],
+                        normal,
+                        1.4,
+                        1.0,
+                    );
+                }
+            }
         }
     }
     obj
 }
 
+/// The point lights of a generated gallery: two per room under the ceiling.
+fn lights(layout: Layout) -> Vec<P> {
+    let mut out = Vec::new();
+    for j in 0..layout.nz {
+        for i in 0..layout.nx {
+            let (x, z) = (ROOM_X * i as f64, ROOM_Z * j as f64);
+            out.push([x + 3.0, 4.3, z + 2.0]);
+            out.push([x + 8.9, 4.3, z + 5.9]);
+        }
+    }
+    out
+}
+
+/// The `scene.toml` of a generated gallery of another size than the shipped one: the shipped
+/// camera, two point lights per room, ε 0.3.
+pub fn scene_toml(options: GalleryOptions) -> String {
+    let layout = Layout {
+        nx: options.rooms[0].max(1),
+        nz: options.rooms[1].max(1),
+    };
+    let mut s = format!(
+        "# A generated gallery of {} × {} rooms (meshlight-gallery --rooms {}x{}).\n\
+         obj = \"gallery.obj\"\n\n[camera]\nposition = [2.0, 1.6, 1.2]\nlook_at = [12.0, 1.5, 4.0]\n\
+         fov_y = 55.0\nwidth = 768\nheight = 512\n",
+        layout.nx, layout.nz, layout.nx, layout.nz
+    );
+    for p in lights(layout) {
+        let _ = write!(
+            s,
+            "\n[[point_light]]\nposition = [{}, {}, {}]\nintensity = [40.0, 38.0, 34.0]\n",
+            num(p[0]),
+            num(p[1]),
+            num(p[2])
+        );
+    }
+    s.push_str("\n[solver]\nepsilon = 0.3\n");
+    s
+}
+
 /// The first line of a generated OBJ: identifies the generator version and options, so a stale
 /// file is regenerated.
 pub fn header(options: GalleryOptions) -> String {
+    let rooms = if options.rooms == GalleryOptions::default().rooms {
+        String::new()
+    } else {
+        format!(" rooms={}x{}", options.rooms[0], options.rooms[1])
+    };
     format!(
-        "# meshlight gallery v1 tile={} sphere_detail={}\n",
+        "# meshlight gallery v1 tile={} sphere_detail={}{rooms}\n",
         options.tile, options.sphere_detail
     )
 }

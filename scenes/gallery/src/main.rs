@@ -1,10 +1,12 @@
-//! `meshlight-gallery [--tile T] [--sphere-detail N] [--out DIR]`: writes the gallery's OBJ
-//! (into scenes/gallery by default; elsewhere with its scene.toml and gallery.mtl beside it).
+//! `meshlight-gallery [--tile T] [--sphere-detail N] [--rooms NXxNZ] [--out DIR]`: writes the
+//! gallery's OBJ (into scenes/gallery by default; elsewhere with its scene.toml and gallery.mtl
+//! beside it). A gallery of another size than the shipped 2x2 rooms needs a folder of its own
+//! and gets a scene.toml written for it (two point lights per room).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use meshlight_gallery::{shipped_dir, write_obj, GalleryOptions};
+use meshlight_gallery::{scene_toml, shipped_dir, write_obj, GalleryOptions};
 
 fn main() -> ExitCode {
     match run() {
@@ -41,22 +43,55 @@ fn run() -> Result<(), String> {
                     return Err("--sphere-detail: at most 6".into());
                 }
             }
+            "--rooms" => {
+                let v = value("--rooms")?;
+                let parse = |x: &str| {
+                    x.trim()
+                        .parse::<usize>()
+                        .ok()
+                        .filter(|&n| (1..=64).contains(&n))
+                };
+                options.rooms = match v.split_once(['x', 'X']) {
+                    Some((a, b)) => match (parse(a), parse(b)) {
+                        (Some(a), Some(b)) => [a, b],
+                        _ => {
+                            return Err(format!(
+                                "--rooms {v}: expected NXxNZ, each 1 to 64 (e.g. 4x4)"
+                            ))
+                        }
+                    },
+                    None => return Err(format!("--rooms {v}: expected NXxNZ, e.g. 4x4")),
+                };
+            }
             "--out" => out = PathBuf::from(value("--out")?),
             "-h" | "--help" => {
                 println!(
-                    "usage: meshlight-gallery [--tile METRES] [--sphere-detail N] [--out DIR]"
+                    "usage: meshlight-gallery [--tile METRES] [--sphere-detail N] [--rooms NXxNZ] [--out DIR]"
                 );
                 return Ok(());
             }
             other => return Err(format!("unknown argument '{other}' (try --help)")),
         }
     }
+    let resized = options.rooms != GalleryOptions::default().rooms;
+    if resized && out == shipped_dir() {
+        return Err(format!(
+            "--rooms {}x{}: a gallery of another size needs a folder of its own (--out DIR); \
+             the shipped one stays 2x2",
+            options.rooms[0], options.rooms[1]
+        ));
+    }
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     if out != shipped_dir() {
-        for file in ["scene.toml", "gallery.mtl"] {
-            std::fs::copy(shipped_dir().join(file), out.join(file))
-                .map_err(|e| format!("{file}: {e}"))?;
+        std::fs::copy(shipped_dir().join("gallery.mtl"), out.join("gallery.mtl"))
+            .map_err(|e| format!("gallery.mtl: {e}"))?;
+        let scene = out.join("scene.toml");
+        if resized {
+            std::fs::write(&scene, scene_toml(options))
+        } else {
+            std::fs::copy(shipped_dir().join("scene.toml"), &scene).map(|_| ())
         }
+        .map_err(|e| format!("{}: {e}", scene.display()))?;
     }
     let stats = write_obj(&out, options).map_err(|e| format!("{}: {e}", out.display()))?;
     println!(

@@ -244,7 +244,13 @@ pub(crate) fn shoot(
                 stats.stop = StopReason::ShotLimit;
                 break;
             }
-            if report(Tick::shooting(stats.shots, stats.unshot_fraction)) == Control::Stop {
+            if report(Tick::shooting(
+                stats.shots,
+                stats.unshot_fraction,
+                stats.initial_unshot_fraction,
+                settings.tolerance,
+            )) == Control::Stop
+            {
                 stats.stop = StopReason::Stopped;
                 break;
             }
