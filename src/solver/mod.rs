@@ -162,6 +162,30 @@ pub fn solve(
     options: &Options,
     progress: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<Solution> {
+    let method = if options.cluster_threshold > 0.0 {
+        Method::Hierarchy
+    } else {
+        Method::Flat
+    };
+    solve_with(scene, vis, options, progress, method)
+}
+
+/// Which shooting solver a solve runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Method {
+    /// Every sample linked to every sample (`flat`).
+    Flat,
+    /// The cluster hierarchy (`cluster`), at the options' threshold, even 0.
+    Hierarchy,
+}
+
+fn solve_with(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &Options,
+    progress: &mut dyn FnMut(&Progress) -> Control,
+    method: Method,
+) -> Result<Solution> {
     check(options)?;
     let (epsilon, epsilon_source) = choose_epsilon(scene, options)?;
     let predicted = predicted_samples(scene, epsilon);
@@ -183,7 +207,7 @@ pub fn solve(
         vis,
         options,
         light: DirectLight::new(scene, options.light_samples),
-        grid: (options.cluster_threshold > 0.0).then(|| TriangleGrid::new(scene)),
+        grid: (method == Method::Hierarchy).then(|| TriangleGrid::new(scene)),
         lift,
         epsilon,
         progress,
@@ -630,4 +654,106 @@ fn check(options: &Options) -> Result<()> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::visibility::Backend;
+
+    /// The shipped room with ε 0.5: a few hundred samples.
+    fn small_room() -> Scene {
+        Scene::load(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/room/scene.toml"))
+            .unwrap()
+    }
+
+    #[test]
+    fn the_hierarchy_at_threshold_zero_is_the_flat_solver() {
+        // Threshold 0 refines every pair of nodes down to single samples: the links are then
+        // the flat solver's form factors and rays, and the row sums its row sums. The flat
+        // solver shoots one sample at a time (Southwell), the hierarchy all at once (Jacobi):
+        // both converge to the one fixed point of the same discrete system, so with a tight
+        // tolerance they agree to far better than 1e-6 — they cannot agree bit for bit, the
+        // order of the additions differs.
+        let scene = small_room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            epsilon: Some(0.5),
+            rounds: 0,
+            tolerance: 1e-10,
+            max_shots: Some(u64::MAX),
+            cluster_threshold: 0.0,
+            ..Options::default()
+        };
+        let go = |method| {
+            solve_with(
+                &scene,
+                vis.as_ref(),
+                &options,
+                &mut |_| Control::Continue,
+                method,
+            )
+            .unwrap()
+        };
+        let (flat, tree) = (go(Method::Flat), go(Method::Hierarchy));
+        let shooting = &tree.rounds[0].shooting;
+        assert!(shooting.links > 0);
+        assert_eq!(
+            shooting.links, shooting.leaf_links,
+            "every link joins two samples"
+        );
+        assert_eq!(flat.samples, tree.samples);
+        for (a, b) in flat.row_scale.iter().zip(&tree.row_scale) {
+            assert!((a - b).abs() <= 1e-6 * a.abs(), "row scales {a} vs {b}");
+        }
+        let mean = flat.radiosity.iter().map(|b| b.element_sum()).sum::<f64>()
+            / (3 * flat.radiosity.len()) as f64;
+        for (k, (a, b)) in flat.radiosity.iter().zip(&tree.radiosity).enumerate() {
+            assert!(
+                (*a - *b).abs().max_element() <= 1e-6 * mean,
+                "sample {k}: flat {a} vs hierarchy {b}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_cluster_tree_is_valid_and_its_check_catches_broken_trees() {
+        let scene = small_room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            rounds: 1,
+            ..Options::default()
+        };
+        let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
+        let grid = TriangleGrid::new(&scene);
+        let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
+        let cx = Context {
+            scene: &scene,
+            grid: &grid,
+            samples: &s.samples,
+            obstruction: &s.obstruction,
+            lift,
+        };
+        let n = s.samples.len();
+        let tree = cluster::tree::Tree::build(&s.samples, &vec![0.5; n], &vec![1.0; n], &cx);
+        assert_eq!(tree.validate(&s.samples), Ok(()));
+        assert_eq!(tree.nodes.len(), n - 1);
+        // Nodes over several sides near the top, single-side subtrees below, and incoherent
+        // nodes where the boxes stand on the floor.
+        assert!(tree
+            .nodes
+            .iter()
+            .any(|node| node.side == cluster::tree::MULTI));
+        assert!(tree.nodes.iter().any(|node| !node.coherent));
+        let mut broken = tree.clone();
+        broken.nodes[0].area *= 1.01;
+        assert!(broken.validate(&s.samples).unwrap_err().contains("totals"));
+        let mut broken = tree.clone();
+        let last = broken.nodes.len() - 1;
+        broken.nodes[last].radius *= 0.5;
+        assert!(broken.validate(&s.samples).is_err());
+        let mut broken = tree;
+        broken.order.swap(0, n - 1);
+        assert!(broken.validate(&s.samples).is_err());
+    }
 }

@@ -1,0 +1,203 @@
+//! The cluster hierarchy against the flat solver it approximates and the physics it must keep:
+//! the image of `room` within 0.5% of the flat solve, the furnace, no light through a wall at
+//! any threshold, queries growing about linearly with the samples, and the same answer for any
+//! number of workers and any pipeline capacity.
+
+mod common;
+
+use common::{backends, shipped, solve, solve_and_render, two_rooms};
+use glam::DVec3;
+use meshlight::solver::{Control, Options, StopReason};
+use meshlight::{Backend, Scene};
+
+fn flat() -> Options {
+    Options {
+        cluster_threshold: 0.0,
+        ..Options::default()
+    }
+}
+
+#[test]
+fn room_at_the_default_threshold_is_within_half_a_percent_of_the_flat_solve() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    for backend in backends() {
+        let (_, reference) = solve_and_render(&scene, backend, flat(), true);
+        let (solution, image) = solve_and_render(&scene, backend, Options::default(), true);
+        assert!(solution
+            .rounds
+            .iter()
+            .all(|r| r.shooting.links > 0 || r.shooting.shots == 0));
+        let e = meshlight::metrics::compare(&image, &reference).unwrap();
+        assert!(
+            e.mae_over_mean <= 0.005,
+            "{backend}: MAE/mean {:.5} against the flat solve",
+            e.mae_over_mean
+        );
+    }
+}
+
+#[test]
+fn furnace_holds_with_the_hierarchy_and_without_it() {
+    // Closed cube, Kd 0.5, Ke 0.1 everywhere: L = Ke / (1 − Kd) = 0.2 at every sample and pixel.
+    let scene = Scene::load(shipped("box")).unwrap();
+    for backend in backends() {
+        for threshold in [0.0, Options::default().cluster_threshold] {
+            let options = Options {
+                tolerance: 1e-5,
+                cluster_threshold: threshold,
+                ..Options::default()
+            };
+            let (s, image) = solve_and_render(&scene, backend, options, true);
+            assert_eq!(s.stop(), StopReason::Converged);
+            let worst_sample = s
+                .radiosity
+                .iter()
+                .map(|b| (b.x / std::f64::consts::PI - 0.2).abs() / 0.2)
+                .fold(0.0, f64::max);
+            let worst_pixel = image
+                .pixels
+                .iter()
+                .map(|p| (f64::from(p.x) - 0.2).abs() / 0.2)
+                .fold(0.0, f64::max);
+            assert!(
+                worst_sample < 0.01 && worst_pixel < 0.01,
+                "{backend}, threshold {threshold}: worst sample {worst_sample:.4}, pixel {worst_pixel:.4}"
+            );
+        }
+    }
+}
+
+#[test]
+fn no_light_goes_through_a_wall_at_the_default_threshold_or_a_hundred_times_it() {
+    // Room B shares a solid wall and one continuous floor with room A, where the light is:
+    // floor clusters reaching under the wall must never carry A's light into B.
+    let scene = two_rooms();
+    for backend in backends() {
+        for factor in [1.0, 100.0] {
+            let options = Options {
+                cluster_threshold: factor * Options::default().cluster_threshold,
+                ..Options::default()
+            };
+            let (s, image) = solve_and_render(&scene, backend, options, true);
+            let shooting = &s.rounds[0].shooting;
+            assert!(
+                shooting.links > shooting.leaf_links,
+                "{backend}: the hierarchy made cluster links"
+            );
+            let (mut dark, mut lit) = (0, 0);
+            for k in 0..s.samples.len() {
+                let x = s.samples.position[k].x;
+                if x > 2.2 {
+                    assert_eq!(
+                        s.radiosity[k],
+                        DVec3::ZERO,
+                        "{backend}, ×{factor}: sample {k} at {} in the dark room",
+                        s.samples.position[k]
+                    );
+                    dark += 1;
+                } else if x < 2.0 && s.radiosity[k].x > 0.0 {
+                    lit += 1;
+                }
+            }
+            assert!(dark > 100 && lit > 100, "{dark} dark, {lit} lit samples");
+            // The camera looks into the dark room.
+            assert!(
+                image.pixels.iter().all(|p| *p == glam::Vec3::ZERO),
+                "{backend}, ×{factor}: the dark room shows light"
+            );
+        }
+    }
+}
+
+/// Visibility queries of a solve of `scene` at ε (no adaptive rounds), and its sample count.
+fn queries(scene: &Scene, epsilon: f32, threshold: f64) -> (u64, usize) {
+    let s = solve(
+        scene,
+        Backend::default_backend(),
+        Options {
+            epsilon: Some(epsilon),
+            rounds: 0,
+            cluster_threshold: threshold,
+            ..Options::default()
+        },
+    );
+    (s.rounds[0].shooting.queries, s.samples.len())
+}
+
+#[test]
+fn from_n_to_4n_samples_queries_grow_less_than_five_times() {
+    // A reduced gallery (big tiles, icosahedra); ε 0.6 → 0.28 about quadruples the samples
+    // (every side keeps at least one, so halving ε alone gives less).
+    let dir = tempfile::tempdir().unwrap();
+    meshlight_gallery::write_obj(
+        dir.path(),
+        meshlight_gallery::GalleryOptions {
+            tile: 0.5,
+            sphere_detail: 0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for file in ["scene.toml", "gallery.mtl"] {
+        std::fs::copy(
+            meshlight_gallery::shipped_dir().join(file),
+            dir.path().join(file),
+        )
+        .unwrap();
+    }
+    let scene = Scene::load(dir.path().join("scene.toml")).unwrap();
+    let threshold = Options::default().cluster_threshold;
+    let (q1, n1) = queries(&scene, 0.6, threshold);
+    let (q4, n4) = queries(&scene, 0.28, threshold);
+    let samples = n4 as f64 / n1 as f64;
+    assert!((3.8..4.6).contains(&samples), "{n1} → {n4} samples");
+    let growth = q4 as f64 / q1 as f64;
+    assert!(
+        growth < 5.0,
+        "hierarchy: {n1} → {n4} samples ({samples:.2}×), queries {q1} → {q4} ({growth:.2}×)"
+    );
+    // The flat solver's grow with the square of the samples.
+    let (f1, _) = queries(&scene, 0.6, 0.0);
+    let (f4, _) = queries(&scene, 0.28, 0.0);
+    let flat = f4 as f64 / f1 as f64;
+    assert!(
+        flat > 0.75 * samples * samples,
+        "flat: queries {f1} → {f4} ({flat:.2}×) for {samples:.2}× the samples"
+    );
+}
+
+#[test]
+fn one_or_two_workers_and_any_pipeline_capacity_give_the_same_answer() {
+    let scene = Scene::load(shipped("room")).unwrap();
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    let run = |threads, pipeline_capacity| {
+        let options = Options {
+            threads,
+            pipeline_capacity,
+            ..Options::default()
+        };
+        meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap()
+    };
+    let reference = run(1, 16);
+    assert!(reference.rounds[0].shooting.links > 0);
+    for (threads, capacity) in [(2, 16), (2, 1), (1, 1), (3, 2)] {
+        let other = run(threads, capacity);
+        assert_eq!(other.samples, reference.samples);
+        assert!(
+            other.radiosity == reference.radiosity,
+            "{threads} workers, capacity {capacity}: radiosity differs"
+        );
+        assert_eq!(
+            other
+                .rounds
+                .iter()
+                .map(|r| r.shooting.links)
+                .collect::<Vec<_>>(),
+            reference
+                .rounds
+                .iter()
+                .map(|r| r.shooting.links)
+                .collect::<Vec<_>>()
+        );
+    }
+}
