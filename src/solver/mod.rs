@@ -12,6 +12,7 @@ mod flat;
 mod form_factor;
 mod normalise;
 mod options;
+mod phases;
 mod pipeline;
 mod progress;
 mod shooting;
@@ -20,24 +21,19 @@ mod warm;
 
 use std::time::Instant;
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 
-use crate::area;
 use crate::error::{Error, Result};
 use crate::light::{Arrival, DirectLight};
-use crate::parallel::for_chunks;
-use crate::sampling::adaptive::{self, RefineSettings};
-use crate::sampling::{
-    poisson, reflecting_sides, surface_of, Obstruction, Samples, SideIndex, SurfaceMap,
-};
+use crate::sampling::{reflecting_sides, surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::scene::Scene;
 use crate::visibility::Visibility;
-use cluster::coherence::{Context, TriangleGrid};
+use cluster::coherence::TriangleGrid;
 pub use options::{Options, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD};
+use phases::{AddedSamples, Solve};
 pub use progress::{Control, Phase, Progress};
-use shooting::{Settings, State, Tick};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
-use warm::{emission, reflectance};
+use warm::reflectance;
 
 /// The solved samples.
 #[derive(Clone, Debug)]
@@ -256,350 +252,6 @@ fn solve_with(
     Ok(solution)
 }
 
-/// A reporter for a phase of a round: hears the share done, tells the host (stopping is
-/// honoured at shots and round boundaries only).
-fn reporter<'a>(
-    progress: &'a mut dyn FnMut(&Progress) -> Control,
-    phase: Phase,
-    round: u32,
-    samples: usize,
-    tolerance: f64,
-) -> impl FnMut(f64) + 'a {
-    move |fraction| {
-        let _ = progress(&Progress {
-            phase,
-            round,
-            samples,
-            shots: 0,
-            unshot_fraction: 1.0,
-            tolerance,
-            fraction,
-        });
-    }
-}
-
-/// What one solve holds across its rounds.
-struct Solve<'a> {
-    scene: &'a Scene,
-    vis: &'a dyn Visibility,
-    options: &'a Options,
-    light: DirectLight,
-    /// The scene's triangles for the hierarchy's coherence tests (none for the flat solver).
-    grid: Option<TriangleGrid>,
-    lift: f32,
-    epsilon: f32,
-    progress: &'a mut dyn FnMut(&Progress) -> Control,
-}
-
-/// Samples an adaptive step (or the initial placement) added.
-#[derive(Clone)]
-struct AddedSamples {
-    added: usize,
-    refined: usize,
-    capped: bool,
-    seconds: f64,
-    /// Per side: whether it has new samples or changed radii (`None`: every side is new).
-    changed: Option<Vec<bool>>,
-}
-
-impl Solve<'_> {
-    fn report(&mut self, phase: Phase, round: u32, samples: usize, tick: Option<Tick>) -> Control {
-        let tick = tick.unwrap_or(Tick {
-            phase,
-            shots: 0,
-            unshot_fraction: 1.0,
-            fraction: 0.0,
-        });
-        (self.progress)(&Progress {
-            phase: tick.phase,
-            round,
-            samples,
-            shots: tick.shots,
-            unshot_fraction: tick.unshot_fraction,
-            tolerance: self.options.tolerance,
-            fraction: tick.fraction,
-        })
-    }
-
-    /// Poisson-disk samples on every reflecting side (eq. 3), each side seeded on its own.
-    fn initial_samples(&mut self, maps: &[SurfaceMap]) -> Result<Samples> {
-        // Stopping is honoured from the first shot on: before it there is no estimate to return.
-        let _ = self.report(Phase::Sampling, 0, 0, None);
-        let sides = reflecting_sides(self.scene);
-        let mut per_side: Vec<Vec<glam::Vec2>> = vec![Vec::new(); sides.len()];
-        let (epsilon, seed) = (self.epsilon, self.options.seed);
-        for_chunks(&mut per_side, 1, self.options.threads.max(1), |i, out| {
-            let side = sides[i];
-            out[0] = poisson::sample_side(&maps[surface_of(side) as usize], side, epsilon, seed);
-            Ok(())
-        })?;
-        let mut samples = Samples::default();
-        for (&side, points) in sides.iter().zip(&per_side) {
-            for &p in points {
-                samples.push(maps, side, p, epsilon, 0);
-            }
-        }
-        Ok(samples)
-    }
-
-    /// One round: areas over all samples, direct light and a warm start for the new ones,
-    /// then shooting.
-    fn round(
-        &mut self,
-        solution: &mut Solution,
-        round: u32,
-        added: &AddedSamples,
-    ) -> Result<RoundStats> {
-        let (scene, vis, options) = (self.scene, self.vis, self.options);
-        let threads = options.threads.max(1);
-        let mut seconds = PhaseSeconds {
-            sampling: added.seconds,
-            ..PhaseSeconds::default()
-        };
-        let n = solution.samples.len();
-        let first_new = n - added.added;
-
-        // Areas over all samples, old and new.
-        let t = Instant::now();
-        let _ = self.report(Phase::Areas, round, n, None);
-        solution.index = SideIndex::new(&solution.samples, &solution.maps, self.epsilon);
-        let area_stats = area::compute(
-            &mut solution.samples,
-            &solution.maps,
-            &solution.index,
-            &solution.obstruction,
-            vis,
-            (self.epsilon, options.alpha),
-            threads,
-            added.changed.as_deref(),
-            &mut reporter(
-                &mut *self.progress,
-                Phase::Areas,
-                round,
-                n,
-                options.tolerance,
-            ),
-        )?;
-        seconds.areas = t.elapsed().as_secs_f64();
-
-        // Direct light at the new samples.
-        let t = Instant::now();
-        let _ = self.report(Phase::DirectLight, round, n, None);
-        let s = &solution.samples;
-        let points: Vec<(Vec3, Vec3)> = (first_new..n)
-            .map(|k| (s.position[k], s.normal[k]))
-            .collect();
-        let ids: Vec<u32> = (first_new as u32..n as u32).collect();
-        let (arrivals, direct_queries) = self.light.at(
-            vis,
-            &points,
-            &ids,
-            options.seed,
-            threads,
-            &mut reporter(
-                &mut *self.progress,
-                Phase::DirectLight,
-                round,
-                n,
-                options.tolerance,
-            ),
-        )?;
-        seconds.direct = t.elapsed().as_secs_f64();
-        warm::start(
-            scene,
-            solution,
-            vis,
-            first_new,
-            &arrivals,
-            self.epsilon,
-            options.alpha,
-            threads,
-        )?;
-        if round == 0 {
-            // Direct light that reached no sample area left the scene.
-            let received: DVec3 = (0..n)
-                .map(|k| solution.direct[k].irradiance * solution.samples.area[k])
-                .sum();
-            solution.ledger.escaped += solution.ledger.emitted - received;
-        }
-
-        // Which new samples see the scene all around (for the row scales).
-        let t = Instant::now();
-        let sides = reflecting_sides(scene);
-        let mut reflecting = vec![false; 2 * scene.surfaces.len()];
-        for &side in &sides {
-            reflecting[side as usize] = true;
-        }
-        let probes = normalise::closed_hemispheres(
-            scene,
-            &reflecting,
-            &solution.samples,
-            first_new,
-            vis,
-            (options.seed, threads),
-            self.lift,
-            &mut reporter(
-                &mut *self.progress,
-                Phase::Links,
-                round,
-                n,
-                options.tolerance,
-            ),
-        )?;
-        solution.closed.extend(probes);
-        let hierarchical = self.grid.is_some();
-        for k in first_new..n {
-            // The flat solver sums rows in its first round only: later samples take the scale
-            // of their nearest old sample. The hierarchy sums every round's rows.
-            let s = &solution.samples;
-            let scale = if round == 0 || hierarchical {
-                1.0
-            } else {
-                solution
-                    .index
-                    .nearest_where(s, s.side[k], s.uv[k], |j| (j as usize) < first_new)
-                    .map_or(1.0, |j| solution.row_scale[j as usize])
-            };
-            solution.row_scale.push(scale);
-        }
-        let probe_seconds = t.elapsed().as_secs_f64();
-
-        // Shoot.
-        let t = Instant::now();
-        let reflectances: Vec<DVec3> = (0..n)
-            .map(|k| reflectance(scene, &solution.samples, k))
-            .collect();
-        let mut state = State {
-            samples: &solution.samples,
-            maps: &solution.maps,
-            reflectance: &reflectances,
-            radiosity: &solution.radiosity,
-            irradiance: &mut solution.irradiance,
-            unshot: &mut solution.unshot,
-            ledger: &mut solution.ledger,
-            row_scale: &mut solution.row_scale,
-            closed: &solution.closed,
-        };
-        let settings = Settings {
-            threads,
-            capacity: options.pipeline_capacity.max(1),
-            tolerance: options.tolerance,
-            max_shots: options.max_shots.unwrap_or(if hierarchical {
-                u64::MAX
-            } else {
-                200 * n as u64
-            }),
-            lift: self.lift,
-            memory_bytes: options.cache_bytes,
-            normalise: round == 0 || hierarchical,
-            threshold: options.cluster_threshold,
-            seed: options.seed,
-        };
-        let progress = &mut *self.progress;
-        let mut link_seconds = None;
-        let link_start = Instant::now();
-        let mut report = |tick: Tick| {
-            if tick.phase == Phase::Shooting && link_seconds.is_none() {
-                link_seconds = Some(link_start.elapsed().as_secs_f64());
-            }
-            progress(&Progress {
-                phase: tick.phase,
-                round,
-                samples: n,
-                shots: tick.shots,
-                unshot_fraction: tick.unshot_fraction,
-                tolerance: options.tolerance,
-                fraction: tick.fraction,
-            })
-        };
-        let shooting = match &self.grid {
-            Some(grid) => {
-                let cx = Context {
-                    scene,
-                    grid,
-                    samples: state.samples,
-                    obstruction: &solution.obstruction,
-                    lift: self.lift,
-                };
-                cluster::shoot(&mut state, vis, &settings, &cx, &mut report)?
-            }
-            None => flat::shoot(&mut state, vis, &settings, &mut report)?,
-        };
-        let total = t.elapsed().as_secs_f64();
-        let linking = link_seconds.unwrap_or(total);
-        if hierarchical {
-            seconds.links = linking + probe_seconds;
-            seconds.shooting = total - linking;
-        } else {
-            seconds.shooting = total + probe_seconds;
-        }
-        for (k, rho) in reflectances.iter().enumerate() {
-            solution.radiosity[k] =
-                emission(scene, &solution.samples, k) + *rho * solution.irradiance[k];
-        }
-        Ok(RoundStats {
-            round,
-            samples: n,
-            added: added.added,
-            refined: added.refined,
-            capped: added.capped,
-            direct_queries,
-            areas: area_stats,
-            shooting,
-            seconds,
-        })
-    }
-
-    /// Adds samples where the error is large (eqs. 7-8), unless told to stop.
-    fn add_samples(&mut self, solution: &mut Solution, round: u32) -> Result<Option<AddedSamples>> {
-        let t = Instant::now();
-        if self.report(Phase::Adaptive, round, solution.samples.len(), None) == Control::Stop {
-            return Ok(None);
-        }
-        let options = self.options;
-        let n = solution.samples.len();
-        let radii = solution.samples.radius.clone();
-        let refinement = adaptive::refine(
-            &mut solution.samples,
-            &solution.maps,
-            &solution.index,
-            &solution.obstruction,
-            self.vis,
-            &solution.radiosity,
-            RefineSettings {
-                epsilon: self.epsilon,
-                zeta: options.zeta,
-                alpha: options.alpha,
-                threads: options.threads.max(1),
-                round: round as u16,
-                seed: options.seed,
-                max_samples: options.max_samples,
-            },
-            &mut reporter(
-                &mut *self.progress,
-                Phase::Adaptive,
-                round,
-                n,
-                options.tolerance,
-            ),
-        )?;
-        let samples = &solution.samples;
-        let mut changed = vec![false; 2 * solution.maps.len()];
-        for k in 0..samples.len() {
-            if radii.get(k) != Some(&samples.radius[k]) {
-                changed[samples.side[k] as usize] = true;
-            }
-        }
-        Ok(Some(AddedSamples {
-            added: refinement.added,
-            refined: refinement.refined,
-            capped: refinement.capped,
-            seconds: t.elapsed().as_secs_f64(),
-            changed: Some(changed),
-        }))
-    }
-}
-
 /// Irradiance arriving at every sample when the samples `shooters` have radiosity `source`,
 /// through the same form factors and visibility the shooting uses (without its clamp): the
 /// meshless transfer on its own, for tests and analysis.
@@ -659,6 +311,7 @@ fn check(options: &Options) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::cluster::coherence::Context;
     use crate::visibility::Backend;
 
     /// The shipped room with ε 0.5: a few hundred samples.
