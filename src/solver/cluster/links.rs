@@ -68,12 +68,6 @@ impl Links {
             + self.cluster.capacity() * std::mem::size_of::<ClusterLink>()
     }
 
-    /// Appends another set of links.
-    pub fn append(&mut self, other: &mut Links) {
-        self.leaf.append(&mut other.leaf);
-        self.cluster.append(&mut other.cluster);
-        self.queries += other.queries;
-    }
 }
 
 /// Pairs taken from the stack per batch of rays.

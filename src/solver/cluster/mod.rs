@@ -33,6 +33,7 @@ use super::progress::Control;
 use super::shooting::{unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
 use crate::error::Result;
+use crate::parallel::for_chunks;
 use crate::visibility::Visibility;
 
 /// Shooters darker than this fraction of the mean radiosity are weighed as this bright in the
@@ -56,10 +57,11 @@ struct Inputs {
     scales: Vec<f32>,
 }
 
-/// One receiver group: its links, and what they delivered to its members in the last sweep.
+/// One receiver group: its links (as the jobs that found them handed them over), and what
+/// they delivered to its members in the last sweep.
 struct Group {
     root: Ref,
-    links: Links,
+    links: Vec<Links>,
     delivered: Vec<DVec3>,
 }
 
@@ -135,7 +137,7 @@ pub(crate) fn shoot(
         .iter()
         .map(|&root| Group {
             root,
-            links: Links::default(),
+            links: Vec::new(),
             delivered: Vec::new(),
         })
         .collect();
@@ -145,24 +147,40 @@ pub(crate) fn shoot(
     let link = |(x, y): (usize, usize)| linker.links_between(roots[x], roots[y]);
     let total = pairs.len();
     let flow = with_pool(threads, settings.capacity, &link, |pool| {
-        pool.run(pairs.iter().copied(), |job, (mut first, mut second)| {
+        pool.run(pairs.iter().copied(), |job, (first, second)| {
             let (x, y) = pairs[job];
             stats.queries += first.queries + second.queries;
-            groups[x].links.append(&mut first);
-            groups[y].links.append(&mut second);
+            for (group, links) in [(x, first), (y, second)] {
+                if !(links.leaf.is_empty() && links.cluster.is_empty()) {
+                    groups[group].links.push(links);
+                }
+            }
             Ok(flow(report(Tick::linking((job + 1) as f64 / total as f64))))
         })
     })?;
-    for group in &mut groups {
-        group.links.leaf.shrink_to_fit();
-        group.links.cluster.shrink_to_fit();
-    }
-    stats.links = groups
-        .iter()
-        .map(|g| (g.links.leaf.len() + g.links.cluster.len()) as u64)
+    // One list per group for the sweeps (which run through them many times), joined in
+    // parallel.
+    for_chunks(&mut groups, 1, threads, |_, group| {
+        let parts = std::mem::take(&mut group[0].links);
+        let mut joined = Links {
+            leaf: Vec::with_capacity(parts.iter().map(|l| l.leaf.len()).sum()),
+            cluster: Vec::with_capacity(parts.iter().map(|l| l.cluster.len()).sum()),
+            queries: 0,
+        };
+        for part in parts {
+            joined.leaf.extend_from_slice(&part.leaf);
+            joined.cluster.extend_from_slice(&part.cluster);
+            joined.queries += part.queries;
+        }
+        group[0].links = vec![joined];
+        Ok(())
+    })?;
+    let all = || groups.iter().flat_map(|g| &g.links);
+    stats.links = all()
+        .map(|l| (l.leaf.len() + l.cluster.len()) as u64)
         .sum();
-    stats.leaf_links = groups.iter().map(|g| g.links.leaf.len() as u64).sum();
-    let link_bytes: usize = groups.iter().map(|g| g.links.bytes()).sum();
+    stats.leaf_links = all().map(|l| l.leaf.len() as u64).sum();
+    let link_bytes: usize = all().map(Links::bytes).sum();
     if flow.is_break() {
         stats.stop = StopReason::Stopped;
         stats.bytes = link_bytes as u64;

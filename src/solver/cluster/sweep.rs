@@ -138,7 +138,7 @@ impl Sources<'_> {
 
     /// The irradiance the links deliver to every member of `group`, in tree order from the
     /// group's first member (cleared first).
-    pub fn gather(&self, group: Ref, links: &Links, out: &mut Vec<DVec3>) {
+    pub fn gather(&self, group: Ref, links: &[Links], out: &mut Vec<DVec3>) {
         let tree = self.tree;
         let (first, count, base, end) = if group.is_leaf() {
             (tree.place[group.index()] as usize, 1, 0, 0)
@@ -157,7 +157,7 @@ impl Sources<'_> {
         // Fields of the group's internal nodes, with E taken at the origin: E + J (x − c) is
         // stored as (E − J c) + J x, so ancestors' fields simply add up on the way down.
         let mut fields = vec![Field::ZERO; end - base];
-        for link in &links.cluster {
+        for link in links.iter().flat_map(|l| &l.cluster) {
             let shooter = self.shooter(link.s);
             let visible = f64::from(link.factor);
             let single = [link.r.index() as u32];
@@ -213,7 +213,7 @@ impl Sources<'_> {
                 }
             }
         }
-        for link in &links.leaf {
+        for link in links.iter().flat_map(|l| &l.leaf) {
             out[place(link.r as usize)] += self.unshot[link.s as usize] * f64::from(link.f);
         }
         if group.is_leaf() {
