@@ -102,19 +102,27 @@ fn main() -> meshlight::Result<()> {
         s.stop(),
         t.elapsed().as_secs_f64()
     );
-    let (s, _) = run(
-        &bright,
-        &Options {
-            max_shots: Some(5000),
-            rounds: 0,
-            ..Options::default()
-        },
-    )?;
-    println!(
-        "albedo 0.99 box, 5000 shots: {:?}, unshot fraction {:.3}, L {:.2} (converged: 10)",
-        s.stop(),
-        s.rounds[0].shooting.unshot_fraction,
-        s.radiosity[0].x / std::f64::consts::PI
-    );
+    // The flat solver shoots one sample at a time, the hierarchy every sample at once: their
+    // shot limits count different things.
+    for (solver, threshold, shots) in [
+        ("hierarchy", Options::default().cluster_threshold, 50),
+        ("flat solver", 0.0, 5000),
+    ] {
+        let (s, _) = run(
+            &bright,
+            &Options {
+                max_shots: Some(shots),
+                rounds: 0,
+                cluster_threshold: threshold,
+                ..Options::default()
+            },
+        )?;
+        println!(
+            "albedo 0.99 box, {solver}, {shots} shots: {:?}, unshot fraction {:.3}, L {:.2} (converged: 10)",
+            s.stop(),
+            s.rounds[0].shooting.unshot_fraction,
+            s.radiosity[0].x / std::f64::consts::PI
+        );
+    }
     Ok(())
 }

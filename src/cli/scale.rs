@@ -60,11 +60,15 @@ pub fn run(
     );
     let mut runs: Vec<Run> = Vec::new();
     let mut last_flat: Option<(usize, f64)> = None;
-    for &epsilon in epsilons {
-        for flat in [false, true] {
+    // The hierarchy's solves first, then the flat solver's, each from the largest ε: memory a
+    // solve freed may stay with the process, and only a larger solve after it measures its own
+    // peak.
+    for flat in [false, true] {
+        for (i, &epsilon) in epsilons.iter().enumerate() {
             if flat {
+                // The hierarchy's solve at this ε says how many samples the flat one will have.
                 let predicted = last_flat.map(|(n, t)| {
-                    let n_now = runs.last().map_or(n, |r| r.samples) as f64;
+                    let n_now = runs.get(i).map_or(n, |r| r.samples) as f64;
                     t * (n_now / n as f64).powi(2)
                 });
                 if predicted.is_some_and(|t| t > flat_limit) {
