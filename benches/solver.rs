@@ -12,8 +12,7 @@ use meshlight::{Backend, Scene};
 fn scenes() -> Vec<(&'static str, Scene, Options)> {
     let room = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/room/scene.toml");
     let dir = std::env::temp_dir().join(format!("meshlight-bench-gallery-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("make a folder for the reduced gallery");
-    meshlight_gallery::write_obj(
+    meshlight_gallery::write_scene(
         &dir,
         meshlight_gallery::GalleryOptions {
             tile: 0.5,
@@ -22,10 +21,6 @@ fn scenes() -> Vec<(&'static str, Scene, Options)> {
         },
     )
     .expect("write the reduced gallery");
-    for file in ["scene.toml", "gallery.mtl"] {
-        std::fs::copy(meshlight_gallery::shipped_dir().join(file), dir.join(file))
-            .expect("copy the gallery's files");
-    }
     let gallery = Scene::load(dir.join("scene.toml")).expect("load the reduced gallery");
     let _ = std::fs::remove_dir_all(&dir);
     vec![

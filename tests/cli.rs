@@ -94,7 +94,7 @@ fn bench_vis_prints_rates_for_every_backend_and_their_agreement() {
 fn gallery_generator_writes_a_loadable_reduced_gallery() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.toml");
-    meshlight_gallery::write_obj(
+    meshlight_gallery::write_scene(
         dir.path(),
         meshlight_gallery::GalleryOptions {
             tile: 0.5,
@@ -103,13 +103,6 @@ fn gallery_generator_writes_a_loadable_reduced_gallery() {
         },
     )
     .unwrap();
-    for file in ["scene.toml", "gallery.mtl"] {
-        std::fs::copy(
-            meshlight_gallery::shipped_dir().join(file),
-            dir.path().join(file),
-        )
-        .unwrap();
-    }
     let out = meshlight(&["info", path.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(

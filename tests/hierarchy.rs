@@ -5,8 +5,7 @@
 
 mod common;
 
-use common::{backends, shipped, solve, solve_and_render, two_rooms};
-use glam::DVec3;
+use common::{assert_dark_room_is_dark, backends, shipped, solve, solve_and_render, two_rooms};
 use meshlight::solver::{Control, Options, StopReason};
 use meshlight::{Backend, Scene};
 
@@ -84,22 +83,7 @@ fn no_light_goes_through_a_wall_at_the_default_threshold_or_a_hundred_times_it()
                 shooting.links > shooting.leaf_links,
                 "{backend}: the hierarchy made cluster links"
             );
-            let (mut dark, mut lit) = (0, 0);
-            for k in 0..s.samples.len() {
-                let x = s.samples.position[k].x;
-                if x > 2.2 {
-                    assert_eq!(
-                        s.radiosity[k],
-                        DVec3::ZERO,
-                        "{backend}, ×{factor}: sample {k} at {} in the dark room",
-                        s.samples.position[k]
-                    );
-                    dark += 1;
-                } else if x < 2.0 && s.radiosity[k].x > 0.0 {
-                    lit += 1;
-                }
-            }
-            assert!(dark > 100 && lit > 100, "{dark} dark, {lit} lit samples");
+            assert_dark_room_is_dark(&s, &format!("{backend}, ×{factor}"));
             // The camera looks into the dark room.
             assert!(
                 image.pixels.iter().all(|p| *p == glam::Vec3::ZERO),
@@ -129,7 +113,7 @@ fn from_n_to_4n_samples_queries_grow_less_than_five_times() {
     // A reduced gallery (big tiles, icosahedra); ε 0.6 → 0.28 about quadruples the samples
     // (every side keeps at least one, so halving ε alone gives less).
     let dir = tempfile::tempdir().unwrap();
-    meshlight_gallery::write_obj(
+    meshlight_gallery::write_scene(
         dir.path(),
         meshlight_gallery::GalleryOptions {
             tile: 0.5,
@@ -138,13 +122,6 @@ fn from_n_to_4n_samples_queries_grow_less_than_five_times() {
         },
     )
     .unwrap();
-    for file in ["scene.toml", "gallery.mtl"] {
-        std::fs::copy(
-            meshlight_gallery::shipped_dir().join(file),
-            dir.path().join(file),
-        )
-        .unwrap();
-    }
     let scene = Scene::load(dir.path().join("scene.toml")).unwrap();
     let threshold = Options::default().cluster_threshold;
     let (q1, n1) = queries(&scene, 0.6, threshold);

@@ -4,7 +4,9 @@
 
 mod common;
 
-use common::{backends, camera, material, shipped, solve, two_rooms, Builder};
+use common::{
+    assert_dark_room_is_dark, backends, camera, material, shipped, solve, two_rooms, Builder,
+};
 use glam::{DVec3, Vec3};
 use meshlight::sampling::{is_back, surface_of};
 use meshlight::scene::PointLight;
@@ -311,6 +313,7 @@ fn point_light_over_a_large_plane_follows_the_inverse_square_law() {
 
 #[test]
 fn no_light_leaks_through_a_shared_wall() {
+    // The flat solver here; the hierarchy in tests/hierarchy.rs.
     let scene = two_rooms();
     for backend in backends() {
         let s = solve(
@@ -318,25 +321,11 @@ fn no_light_leaks_through_a_shared_wall() {
             backend,
             Options {
                 rounds: 2,
+                cluster_threshold: 0.0,
                 ..Options::default()
             },
         );
-        let (mut dark, mut lit) = (0, 0);
-        for k in 0..s.samples.len() {
-            let x = s.samples.position[k].x;
-            if x > 2.2 {
-                assert_eq!(
-                    s.radiosity[k],
-                    DVec3::ZERO,
-                    "{backend}: sample {k} at {} in the dark room",
-                    s.samples.position[k]
-                );
-                dark += 1;
-            } else if x < 2.0 && s.radiosity[k].x > 0.0 {
-                lit += 1;
-            }
-        }
-        assert!(dark > 100 && lit > 100, "{dark} dark, {lit} lit samples");
+        assert_dark_room_is_dark(&s, &format!("{backend}, flat"));
     }
 }
 

@@ -28,7 +28,7 @@ use super::form_factor::{segment, Shooter};
 use super::normalise::row_scale;
 use super::pipeline::with_pool;
 use super::progress::Control;
-use super::shooting::{unshot_power, Settings, State, Tick};
+use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
 
 /// Visibility already known: row j holds, once sample j has shot, which samples see it.
@@ -96,14 +96,13 @@ pub(crate) fn shoot(
     settings: &Settings,
     report: &mut dyn FnMut(Tick) -> Control,
 ) -> Result<ShootStats> {
+    if let Some(stats) = nothing_to_shoot(state) {
+        return Ok(stats);
+    }
     let samples = state.samples;
     let n = samples.len();
     let emitted = state.ledger.emitted.element_sum();
     let mut stats = ShootStats::new();
-    if emitted <= 0.0 || n == 0 {
-        stats.stop = StopReason::NoLight;
-        return Ok(stats);
-    }
     let threads = settings.threads.max(1);
     let chunk = n.div_ceil(4 * threads).max(512);
     // The bit matrix is worth it within half the memory budget only.

@@ -90,3 +90,13 @@ impl Tick {
 pub(crate) fn unshot_power(unshot: DVec3, area: f64) -> f64 {
     unshot.abs().element_sum() * area
 }
+
+/// The stats of a solve with nothing to shoot (no light, or no samples), if so.
+pub(crate) fn nothing_to_shoot(state: &State) -> Option<super::stats::ShootStats> {
+    let emitted = state.ledger.emitted.element_sum();
+    (emitted <= 0.0 || state.samples.is_empty()).then(|| {
+        let mut stats = super::stats::ShootStats::new();
+        stats.stop = super::stats::StopReason::NoLight;
+        stats
+    })
+}

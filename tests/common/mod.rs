@@ -222,3 +222,27 @@ pub fn two_rooms() -> Scene {
         32,
     ))
 }
+
+/// Checks a solve of [`two_rooms`]: every sample of the dark room (x > 2.2) exactly 0, and
+/// enough samples on both sides for that to mean something.
+pub fn assert_dark_room_is_dark(s: &meshlight::Solution, label: &str) {
+    let (mut dark, mut lit) = (0, 0);
+    for k in 0..s.samples.len() {
+        let x = s.samples.position[k].x;
+        if x > 2.2 {
+            assert_eq!(
+                s.radiosity[k],
+                glam::DVec3::ZERO,
+                "{label}: sample {k} at {} in the dark room",
+                s.samples.position[k]
+            );
+            dark += 1;
+        } else if x < 2.0 && s.radiosity[k].x > 0.0 {
+            lit += 1;
+        }
+    }
+    assert!(
+        dark > 100 && lit > 100,
+        "{label}: {dark} dark, {lit} lit samples"
+    );
+}

@@ -635,6 +635,24 @@ pub fn write_obj(dir: &Path, options: GalleryOptions) -> io::Result<Stats> {
     })
 }
 
+/// Writes a whole scene into `dir`: `gallery.obj`, and unless `dir` is the shipped folder,
+/// `gallery.mtl` and `scene.toml` beside it (the shipped ones, or for a gallery of another size
+/// one written for it).
+pub fn write_scene(dir: &Path, options: GalleryOptions) -> io::Result<Stats> {
+    std::fs::create_dir_all(dir)?;
+    // Compared as real paths: copying a file onto itself would empty it.
+    let shipped = std::fs::canonicalize(shipped_dir())?;
+    if std::fs::canonicalize(dir)? != shipped {
+        std::fs::copy(shipped_dir().join("gallery.mtl"), dir.join("gallery.mtl"))?;
+        if options.rooms == GalleryOptions::default().rooms {
+            std::fs::copy(shipped_dir().join("scene.toml"), dir.join("scene.toml"))?;
+        } else {
+            std::fs::write(dir.join("scene.toml"), scene_toml(options))?;
+        }
+    }
+    write_obj(dir, options)
+}
+
 /// This crate's own folder: `scenes/gallery`, where `scene.toml` and `gallery.mtl` live.
 pub fn shipped_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

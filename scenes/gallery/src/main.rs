@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use meshlight_gallery::{scene_toml, shipped_dir, write_obj, GalleryOptions};
+use meshlight_gallery::{shipped_dir, write_scene, GalleryOptions};
 
 fn main() -> ExitCode {
     match run() {
@@ -73,27 +73,14 @@ fn run() -> Result<(), String> {
             other => return Err(format!("unknown argument '{other}' (try --help)")),
         }
     }
-    let resized = options.rooms != GalleryOptions::default().rooms;
-    if resized && out == shipped_dir() {
+    if options.rooms != GalleryOptions::default().rooms && out == shipped_dir() {
         return Err(format!(
             "--rooms {}x{}: a gallery of another size needs a folder of its own (--out DIR); \
              the shipped one stays 2x2",
             options.rooms[0], options.rooms[1]
         ));
     }
-    std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    if out != shipped_dir() {
-        std::fs::copy(shipped_dir().join("gallery.mtl"), out.join("gallery.mtl"))
-            .map_err(|e| format!("gallery.mtl: {e}"))?;
-        let scene = out.join("scene.toml");
-        if resized {
-            std::fs::write(&scene, scene_toml(options))
-        } else {
-            std::fs::copy(shipped_dir().join("scene.toml"), &scene).map(|_| ())
-        }
-        .map_err(|e| format!("{}: {e}", scene.display()))?;
-    }
-    let stats = write_obj(&out, options).map_err(|e| format!("{}: {e}", out.display()))?;
+    let stats = write_scene(&out, options).map_err(|e| format!("{}: {e}", out.display()))?;
     println!(
         "wrote {} ({} vertices, {} triangles)",
         out.join("gallery.obj").display(),

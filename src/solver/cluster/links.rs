@@ -67,7 +67,6 @@ impl Links {
         self.leaf.capacity() * std::mem::size_of::<LeafLink>()
             + self.cluster.capacity() * std::mem::size_of::<ClusterLink>()
     }
-
 }
 
 /// Pairs taken from the stack per batch of rays.

@@ -30,7 +30,7 @@ use self::tree::{Ref, Tree};
 use super::normalise::row_scale;
 use super::pipeline::with_pool;
 use super::progress::Control;
-use super::shooting::{unshot_power, Settings, State, Tick};
+use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
 use crate::error::Result;
 use crate::parallel::for_chunks;
@@ -74,14 +74,13 @@ pub(crate) fn shoot(
     cx: &Context,
     report: &mut dyn FnMut(Tick) -> Control,
 ) -> Result<ShootStats> {
+    if let Some(stats) = nothing_to_shoot(state) {
+        return Ok(stats);
+    }
     let samples = state.samples;
     let n = samples.len();
     let emitted = state.ledger.emitted.element_sum();
     let mut stats = ShootStats::new();
-    if emitted <= 0.0 || n == 0 {
-        stats.stop = StopReason::NoLight;
-        return Ok(stats);
-    }
 
     // Nothing to do where the warm start left less than the tolerance unshot.
     let unshot: f64 = (0..n)
@@ -176,9 +175,7 @@ pub(crate) fn shoot(
         Ok(())
     })?;
     let all = || groups.iter().flat_map(|g| &g.links);
-    stats.links = all()
-        .map(|l| (l.leaf.len() + l.cluster.len()) as u64)
-        .sum();
+    stats.links = all().map(|l| (l.leaf.len() + l.cluster.len()) as u64).sum();
     stats.leaf_links = all().map(|l| l.leaf.len() as u64).sum();
     let link_bytes: usize = all().map(Links::bytes).sum();
     if flow.is_break() {
