@@ -59,6 +59,9 @@ struct Knobs {
     /// Cluster hierarchy error threshold, relative to the mean radiosity (0: the flat solver).
     #[arg(long)]
     cluster_threshold: Option<f64>,
+    /// Refine every partly visible cluster link down to samples, however faint (slower).
+    #[arg(long)]
+    exact_visibility: bool,
     /// Visibility backend: embree or bvh.
     #[arg(long)]
     backend: Option<Backend>,

@@ -72,9 +72,10 @@ fn no_light_goes_through_a_wall_at_the_default_threshold_or_a_hundred_times_it()
     // floor clusters reaching under the wall must never carry A's light into B.
     let scene = two_rooms();
     for backend in backends() {
-        for factor in [1.0, 100.0] {
+        for (factor, exact_visibility) in [(1.0, false), (100.0, false), (1.0, true)] {
             let options = Options {
                 cluster_threshold: factor * Options::default().cluster_threshold,
+                exact_visibility,
                 ..Options::default()
             };
             let (s, image) = solve_and_render(&scene, backend, options, true);
@@ -83,11 +84,12 @@ fn no_light_goes_through_a_wall_at_the_default_threshold_or_a_hundred_times_it()
                 shooting.links > shooting.leaf_links,
                 "{backend}: the hierarchy made cluster links"
             );
-            assert_dark_room_is_dark(&s, &format!("{backend}, ×{factor}"));
+            let label = format!("{backend}, ×{factor}, exact visibility {exact_visibility}");
+            assert_dark_room_is_dark(&s, &label);
             // The camera looks into the dark room.
             assert!(
                 image.pixels.iter().all(|p| *p == glam::Vec3::ZERO),
-                "{backend}, ×{factor}: the dark room shows light"
+                "{label}: the dark room shows light"
             );
         }
     }

@@ -295,6 +295,7 @@ pub fn solve_setup(
     o.max_shots = args.max_shots.or(o.max_shots);
     o.max_samples = args.max_samples.unwrap_or(o.max_samples);
     o.cluster_threshold = args.cluster_threshold.unwrap_or(o.cluster_threshold);
+    o.exact_visibility |= args.exact_visibility;
     o.backend = args.backend.unwrap_or(o.backend);
     o.threads = args.threads.unwrap_or(o.threads).max(1);
     o.seed = args.seed.unwrap_or(o.seed);

@@ -38,6 +38,14 @@ pub struct Options {
     /// Useful 0.01–1: larger is faster and coarser. 0 selects the flat solver (every sample
     /// linked to every sample, O(N²)), the reference the hierarchy is measured against.
     pub cluster_threshold: f64,
+    /// Refine every partly visible link of the hierarchy down to single samples. By default a
+    /// partly visible link whose whole transfer is below a quarter of the error threshold
+    /// carries the visible share its probes measured (no wall is ever crossed: clusters never
+    /// straddle an occluder). Exact visibility sharpens faint penumbrae at a cost that grows
+    /// faster than the samples: on the shipped gallery 3.9 s instead of 2.9 s, and a
+    /// 99th-percentile pixel error against the flat solve of 1.4% instead of 4.7%; at 179k
+    /// samples 91 M links and 2.4 GB instead of 4.4 M and 0.7 GB.
+    pub exact_visibility: bool,
     /// Memory the flat solver may use to keep each shooter's visible receivers and form
     /// factors (bytes; 0 disables): re-shooting a kept sample costs no visibility query.
     /// Results do not depend on it, only time.
@@ -71,6 +79,7 @@ impl Default for Options {
             max_shots: None,
             max_samples: 2_000_000,
             cluster_threshold: DEFAULT_CLUSTER_THRESHOLD,
+            exact_visibility: false,
             cache_bytes: 2 << 30,
             threads: std::thread::available_parallelism()
                 .map_or(2, |n| n.get())

@@ -257,6 +257,7 @@ impl Solve<'_> {
             memory_bytes: options.cache_bytes,
             normalise: round == 0 || hierarchical,
             threshold: options.cluster_threshold,
+            exact_visibility: options.exact_visibility,
             seed: options.seed,
         };
         let progress = &mut *self.progress;

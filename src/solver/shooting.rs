@@ -41,6 +41,8 @@ pub(crate) struct Settings {
     pub normalise: bool,
     /// The hierarchy's error threshold (0: the flat solver).
     pub threshold: f64,
+    /// Refine every partly visible link of the hierarchy, however faint.
+    pub exact_visibility: bool,
     /// The seed of the hierarchy's visibility rays.
     pub seed: u64,
 }

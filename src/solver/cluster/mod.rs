@@ -128,6 +128,7 @@ pub(crate) fn shoot(
         vis,
         lift: settings.lift,
         tolerance: settings.threshold * reference,
+        faint_links: !settings.exact_visibility,
         seed: settings.seed,
     };
     // Every pair of groups (each group with itself too), as jobs; each job's links go to
