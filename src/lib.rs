@@ -27,6 +27,7 @@ pub mod light;
 pub mod metrics;
 mod parallel;
 pub mod ply;
+pub mod reference;
 pub mod render;
 pub mod sampling;
 pub mod scene;

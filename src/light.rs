@@ -25,6 +25,8 @@ struct Emitter {
     normal: Vec3,
     offset: f32,
     ke: DVec3,
+    /// Whether its front reflects light too (then it has samples of its own).
+    reflects: bool,
 }
 
 /// Direct light from a scene's lights.
@@ -42,6 +44,9 @@ pub struct Arrival {
     pub irradiance: DVec3,
     /// Fraction of the unoccluded irradiance that arrives (1 fully lit, 0 in full shadow).
     pub visible: f32,
+    /// The form factor, as visible, from the point to the emitters that do not reflect:
+    /// the part of its hemisphere that sends light but takes none back.
+    pub dark_emitters: f64,
 }
 
 impl DirectLight {
@@ -71,6 +76,7 @@ impl DirectLight {
                     normal: surface.normal,
                     offset: surface.offset,
                     ke: scene.material_of(s).ke.as_dvec3(),
+                    reflects: scene.material_of(s).kd.max_element() > 0.0,
                 }
             })
             .collect();
@@ -149,6 +155,8 @@ impl DirectLight {
         // Per receiver and emitter: analytic irradiance, Σ weights, Σ visible weights.
         let ne = self.emitters.len();
         let mut analytic = vec![DVec3::ZERO; points.len() * ne];
+        // Per receiver and emitter: the unoccluded form factor, for emitters that do not reflect.
+        let mut factor = vec![0.0f64; points.len() * ne];
         let mut weights = vec![[0.0f64; 2]; points.len() * ne];
         let mut unoccluded = vec![0.0f64; points.len()];
         for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
@@ -187,6 +195,9 @@ impl DirectLight {
                     continue;
                 }
                 analytic[r * ne + e] = emitter.ke * irradiance;
+                if !emitter.reflects {
+                    factor[r * ne + e] = irradiance / std::f64::consts::PI;
+                }
                 unoccluded[r] += (emitter.ke * irradiance).element_sum();
                 let total = *emitter.cumulative.last().unwrap_or(&0.0);
                 let count = self.light_samples;
@@ -237,10 +248,12 @@ impl DirectLight {
         }
         for (r, o) in out.iter_mut().enumerate() {
             let mut h = arrived[r];
+            let mut dark_emitters = 0.0;
             for e in 0..ne {
                 let [all, visible] = weights[r * ne + e];
                 if all > 0.0 {
                     h += analytic[r * ne + e] * (visible / all);
+                    dark_emitters += factor[r * ne + e] * (visible / all);
                 }
             }
             let full = unoccluded[r];
@@ -251,6 +264,7 @@ impl DirectLight {
                 } else {
                     0.0
                 },
+                dark_emitters,
             };
         }
         Ok(segments.len() as u64)

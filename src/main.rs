@@ -73,6 +73,15 @@ struct Knobs {
     seed: Option<u64>,
 }
 
+/// How `render` computes its image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Method {
+    /// The meshless solver, then interpolation at camera-ray hits.
+    Meshless,
+    /// Unbiased Monte Carlo path tracing: the reference.
+    Pathtrace,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Solve a scene and render its camera view: linear OpenEXR plus a tone-mapped PNG beside it.
@@ -85,6 +94,16 @@ enum Command {
         /// Rays per side on pixels that straddle an edge (1 = one ray per pixel).
         #[arg(long, default_value_t = 4)]
         supersample: u32,
+        /// How to compute the image: meshless (the solver), or pathtrace (the independent
+        /// reference: unbiased Monte Carlo path tracing).
+        #[arg(long, default_value = "meshless")]
+        method: Method,
+        /// Path tracing: samples per pixel.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Path tracing: stop after this many seconds (with fewer samples per pixel).
+        #[arg(long)]
+        time: Option<f64>,
     },
     /// Compare an image with a reference: mean absolute error / mean (the paper's measure) and more.
     Compare {
@@ -170,10 +189,41 @@ fn run(args: Args) -> anyhow::Result<()> {
             solve,
             output,
             supersample,
+            method,
+            spp,
+            time,
         } => {
             let started = std::time::Instant::now();
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
             let vis = options.backend.build(&scene)?;
+            if method == Method::Pathtrace {
+                let path_options = meshlight::reference::PathOptions {
+                    spp,
+                    seconds: time,
+                    seed: options.seed,
+                    threads: options.threads,
+                    ..Default::default()
+                };
+                let traced = cli::path_trace_with_progress(&scene, vis.as_ref(), &path_options)?;
+                traced.image.write_exr(&output)?;
+                let png = output.with_extension("png");
+                traced.image.write_png(&png, traced.image.auto_exposure())?;
+                print!(
+                    "{}",
+                    cli::path_summary(&scene, &traced, &path_options, &options)
+                );
+                println!(
+                    "total {:.2} s{}; wrote {} and {}",
+                    started.elapsed().as_secs_f64(),
+                    cli::memory::peak_bytes().map_or(String::new(), |b| format!(
+                        ", peak memory {}",
+                        cli::memory::human(b)
+                    )),
+                    output.display(),
+                    png.display()
+                );
+                return Ok(());
+            }
             let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
             let render_options = meshlight::RenderOptions {
                 threads: options.threads,

@@ -174,7 +174,7 @@ pub(crate) fn shoot(
                 }
             }
             for (i, scale) in state.row_scale.iter_mut().enumerate() {
-                *scale = row_scale(sums[i], state.closed[i]);
+                *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
             }
             for kept in cache.iter_mut().flatten() {
                 for (i, f) in kept.0.iter_mut() {

@@ -233,6 +233,7 @@ impl Solve<'_> {
         let reflectances: Vec<DVec3> = (0..n)
             .map(|k| reflectance(scene, &solution.samples, k))
             .collect();
+        let dark_emitters: Vec<f64> = solution.direct.iter().map(|a| a.dark_emitters).collect();
         let mut state = State {
             samples: &solution.samples,
             maps: &solution.maps,
@@ -243,6 +244,7 @@ impl Solve<'_> {
             ledger: &mut solution.ledger,
             row_scale: &mut solution.row_scale,
             closed: &solution.closed,
+            dark_emitters: &dark_emitters,
         };
         let settings = Settings {
             threads,

@@ -25,6 +25,8 @@ pub(crate) struct State<'a> {
     pub row_scale: &'a mut [f32],
     /// Per receiver, whether every probe ray from it hit the scene.
     pub closed: &'a [bool],
+    /// Per receiver, the form factor to emitters that do not reflect (see `normalise`).
+    pub dark_emitters: &'a [f64],
 }
 
 /// Settings of one solve.

@@ -229,7 +229,7 @@ pub(crate) fn shoot(
             })?;
             groups = kept;
             for (i, scale) in state.row_scale.iter_mut().enumerate() {
-                *scale = row_scale(sums[i], state.closed[i]);
+                *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
             }
         }
 
