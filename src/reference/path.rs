@@ -268,10 +268,17 @@ impl Tracer<'_> {
         let mut paths: Vec<Path> = Vec::with_capacity(out.len() * samples.len());
         for (i, _) in out.iter().enumerate() {
             let pixel = start + i;
+            // Where in the pixel: the R2 sequence (Roberts 2018), rotated per pixel, so the
+            // box filter is integrated evenly whatever the sample count.
+            let mut shift = Pcg64Mcg::seed_from_u64(stream(self.seed, pixel as u64, u32::MAX));
+            let rotation: (f64, f64) = (shift.random(), shift.random());
             for sample in samples.clone() {
-                let mut rng = Pcg64Mcg::seed_from_u64(stream(self.seed, pixel as u64, sample));
-                let x = (pixel % width) as f32 + rng.random::<f32>();
-                let y = (pixel / width) as f32 + rng.random::<f32>();
+                let rng = Pcg64Mcg::seed_from_u64(stream(self.seed, pixel as u64, sample));
+                let k = f64::from(sample);
+                let u = (rotation.0 + k * 0.754_877_666_246_692_8).fract() as f32;
+                let v = (rotation.1 + k * 0.569_840_290_998_053_3).fract() as f32;
+                let x = (pixel % width) as f32 + u;
+                let y = (pixel / width) as f32 + v;
                 paths.push(Path {
                     pixel,
                     sample,

@@ -98,9 +98,22 @@ pub fn render(
         let mut rays = Vec::with_capacity(out.len() * n * n);
         for &p in &edges[first..first + out.len()] {
             let (x, y) = ((p % w) as f32, (p / w) as f32);
+            // Stratified and jittered: a regular grid measures a straight edge's coverage in
+            // steps of 1/n with the same error all along the edge, which biased the mean of a
+            // small image by the bright edge pixels of a light.
+            let mut h = p as u64 ^ 0x5851_f42d_4c95_7f2d;
+            let mut jitter = || {
+                h = h
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                ((h >> 40) as f32) / (1u64 << 24) as f32
+            };
             for j in 0..n {
                 for i in 0..n {
-                    let (dx, dy) = ((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                    let (dx, dy) = (
+                        (i as f32 + jitter()) / n as f32,
+                        (j as f32 + jitter()) / n as f32,
+                    );
                     rays.push(camera_ray(scene, x + dx, y + dy));
                 }
             }

@@ -1,0 +1,189 @@
+//! The path tracer, the reference everything else is measured against, against answers known
+//! without it: the furnace, a point light over a plane, its own noise estimate, and the same
+//! image for any thread count. Then the meshless solver against it.
+
+mod common;
+
+use common::{backends, camera, material, shipped, Builder};
+use glam::{DVec3, Vec3};
+use meshlight::reference::{path_trace, PathImage, PathOptions};
+use meshlight::scene::PointLight;
+use meshlight::{Backend, Scene};
+
+fn trace(scene: &Scene, backend: Backend, options: PathOptions) -> PathImage {
+    let vis = backend.build(scene).unwrap();
+    path_trace(scene, vis.as_ref(), &options, &mut |_| {}).unwrap()
+}
+
+/// A shipped scene with a smaller image.
+fn small(name: &str, size: u32) -> Scene {
+    let mut scene = Scene::load(shipped(name)).unwrap();
+    scene.camera.width = size;
+    scene.camera.height = size;
+    scene
+}
+
+#[test]
+fn furnace_is_ke_over_one_minus_kd_everywhere() {
+    // Closed cube, Kd 0.5, Ke 0.1 on every face: L = 0.1 / (1 − 0.5) = 0.2 at every pixel.
+    let scene = small("box", 32);
+    for backend in backends() {
+        let traced = trace(
+            &scene,
+            backend,
+            PathOptions {
+                spp: 512,
+                ..PathOptions::default()
+            },
+        );
+        let mean = traced.image.mean();
+        let mae = traced
+            .image
+            .pixels
+            .iter()
+            .map(|p| (p.as_dvec3() - DVec3::splat(0.2)).abs().element_sum() / 3.0)
+            .sum::<f64>()
+            / traced.image.pixels.len() as f64
+            / 0.2;
+        assert!(
+            traced.noise > 0.0 && traced.noise < 0.02,
+            "noise {}",
+            traced.noise
+        );
+        // The image's error is its noise, within a third of it, and the mean within 1%.
+        assert!(
+            (mae - traced.noise).abs() < 0.35 * traced.noise,
+            "{backend}: MAE/mean {mae:.5} against the noise estimate {:.5}",
+            traced.noise
+        );
+        assert!((mean - 0.2).abs() < 0.01 * 0.2, "{backend}: mean {mean}");
+    }
+}
+
+#[test]
+fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
+    let mut builder = Builder::default();
+    let grey = builder.material(material("grey", 0.5, 0.0));
+    builder.quad(
+        [
+            Vec3::new(-20., 0., -20.),
+            Vec3::new(-20., 0., 20.),
+            Vec3::new(20., 0., 20.),
+            Vec3::new(20., 0., -20.),
+        ],
+        grey,
+    );
+    let light = Vec3::new(0.3, 1.5, -0.2);
+    let intensity = 7.0;
+    builder.point_lights.push(PointLight {
+        position: light,
+        intensity: Vec3::splat(intensity),
+    });
+    let scene = builder.scene(camera(Vec3::new(0.0, 3.0, 2.5), Vec3::ZERO, 24));
+    // The analytic answer, averaged over each pixel (box filter) on a 16 × 16 grid: the radiance
+    // of the plane where the ray lands, Kd/π · I · cosθ / r².
+    let c = &scene.camera;
+    let radiance = |x: f32, y: f32| -> f64 {
+        let d = c.direction(x, y).as_dvec3();
+        let o = c.position.as_dvec3();
+        if d.y >= 0.0 {
+            return 0.0;
+        }
+        let p = o + d * (-o.y / d.y);
+        let to = light.as_dvec3() - p;
+        if p.x.abs() > 20.0 || p.z.abs() > 20.0 {
+            return 0.0;
+        }
+        0.5 / std::f64::consts::PI * f64::from(intensity) * (to.y / to.length())
+            / to.length_squared()
+    };
+    for backend in backends() {
+        let traced = trace(
+            &scene,
+            backend,
+            PathOptions {
+                spp: 256,
+                ..PathOptions::default()
+            },
+        );
+        for (i, p) in traced.image.pixels.iter().enumerate() {
+            let (px, py) = ((i % 24) as f32, (i / 24) as f32);
+            let expected: f64 = (0..16 * 16)
+                .map(|k| {
+                    radiance(
+                        px + ((k % 16) as f32 + 0.5) / 16.0,
+                        py + ((k / 16) as f32 + 0.5) / 16.0,
+                    )
+                })
+                .sum::<f64>()
+                / 256.0;
+            let got = f64::from(p.x);
+            assert!(
+                (got - expected).abs() <= 0.01 * expected + 1e-9,
+                "{backend}: pixel {i}: {got} vs {expected}"
+            );
+        }
+    }
+}
+
+#[test]
+fn two_seeds_agree_within_three_times_their_noise_and_threads_do_not_matter() {
+    let scene = small("room", 48);
+    let run = |seed, threads| {
+        trace(
+            &scene,
+            Backend::default_backend(),
+            PathOptions {
+                spp: 64,
+                seed,
+                threads,
+                ..PathOptions::default()
+            },
+        )
+    };
+    let (a, b) = (run(1, 2), run(2, 2));
+    let e = meshlight::metrics::compare(&a.image, &b.image).unwrap();
+    // Two independent images differ by √2 times each one's error: their noise estimates say
+    // how much.
+    let expected = std::f64::consts::SQRT_2 * 0.5 * (a.noise + b.noise);
+    assert!(
+        e.mae_over_mean < 3.0 * expected && e.mae_over_mean > expected / 3.0,
+        "MAE/mean between seeds {:.4}, noise estimates {:.4} and {:.4}",
+        e.mae_over_mean,
+        a.noise,
+        b.noise
+    );
+    let one = run(1, 1);
+    assert!(one.image == a.image, "1 and 2 threads differ");
+    assert_eq!(one.halves, a.halves);
+}
+
+#[test]
+fn meshless_room_is_within_two_percent_of_the_path_tracer_without_bias() {
+    // A reduced room: 128 × 128 pixels (smaller, the edges of the light dominate the error),
+    // the path tracer at 1024 samples per pixel (noise under 1%), the meshless solver at its
+    // defaults on every backend.
+    let scene = small("room", 128);
+    let reference = trace(
+        &scene,
+        Backend::default_backend(),
+        PathOptions {
+            spp: 1024,
+            ..PathOptions::default()
+        },
+    );
+    assert!(reference.noise < 0.01, "noise {}", reference.noise);
+    for backend in backends() {
+        let (_, image) =
+            common::solve_and_render(&scene, backend, meshlight::Options::default(), true);
+        let e = meshlight::metrics::compare(&image, &reference.image).unwrap();
+        let bias = image.mean() / reference.image.mean() - 1.0;
+        assert!(
+            e.mae_over_mean <= 0.02 && bias.abs() <= 0.005,
+            "{backend}: MAE/mean {:.4}, bias {:+.4} (path tracer noise {:.4})",
+            e.mae_over_mean,
+            bias,
+            reference.noise
+        );
+    }
+}
