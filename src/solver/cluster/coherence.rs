@@ -175,6 +175,50 @@ fn splits(normal: Vec3, point: Vec3, lo: Vec3, hi: Vec3, members: &[u32], cx: &C
     false
 }
 
+/// Whether something hovers close in front of the members of a one-side node (within `depth`
+/// of its plane, over their footprint): a light fixture under a ceiling, a canvas before a wall.
+/// Such a node may hold members that see a shooter and members sheltered from it, in a gap the
+/// probes of a faint link can miss; light is never averaged into it. Nodes over several sides
+/// count as sheltered.
+pub(crate) fn sheltered(
+    cx: &Context,
+    side: Option<u32>,
+    normal: Vec3,
+    lo: Vec3,
+    hi: Vec3,
+    depth: f32,
+) -> bool {
+    let Some(side) = side else { return true };
+    let surface = side / 2;
+    // The members' box, shrunk across the plane by the lift (a wall meeting the side along the
+    // footprint's edge does not shelter it), and reaching `depth` in front.
+    let pad = Vec3::splat(cx.lift) * (Vec3::ONE - normal.abs());
+    let (blo, bhi) = (
+        (lo + pad).min(lo + pad + depth * normal),
+        (hi - pad).max(hi - pad + depth * normal),
+    );
+    let base = normal.dot(lo);
+    let mut poly: Vec<Vec3> = Vec::with_capacity(9);
+    let mut scratch: Vec<Vec3> = Vec::with_capacity(9);
+    cx.grid.any(blo, bhi, |t| {
+        let tri = &cx.scene.triangles[t as usize];
+        if tri.surface == surface {
+            return false;
+        }
+        poly.clear();
+        poly.extend_from_slice(&tri.vertices);
+        clip_half_space(&mut poly, &mut scratch, normal, base + cx.lift);
+        clip_half_space(&mut poly, &mut scratch, -normal, -(base + depth));
+        for axis in 0..3 {
+            let mut n = Vec3::ZERO;
+            n[axis] = 1.0;
+            clip_half_space(&mut poly, &mut scratch, n, blo[axis]);
+            clip_half_space(&mut poly, &mut scratch, -n, -bhi[axis]);
+        }
+        !poly.is_empty()
+    })
+}
+
 /// Whether a triangle meets an axis-aligned box (clipped to its six planes, something is left).
 fn meets_box(t: &[Vec3; 3], lo: Vec3, hi: Vec3) -> bool {
     let (tlo, thi) = bounds(t);

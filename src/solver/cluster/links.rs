@@ -101,10 +101,24 @@ pub(crate) struct Linker<'a> {
     pub seed: u64,
 }
 
+/// Directions of a pair still wanted: light into b (from a), into a (from b).
+const INTO_B: u8 = 1;
+const INTO_A: u8 = 2;
+const BOTH: u8 = INTO_B | INTO_A;
+
+/// A pair of nodes on the stack, with the directions still to link.
+#[derive(Clone, Copy, Debug)]
+struct Pair {
+    a: Ref,
+    b: Ref,
+    dirs: u8,
+}
+
 /// A pair waiting for its rays: probes `first..first + probes` of the wave.
 struct Pending {
     a: Ref,
     b: Ref,
+    dirs: u8,
     first: usize,
     probes: usize,
     kind: Kind,
@@ -144,7 +158,7 @@ impl Linker<'_> {
     /// itself), in both directions.
     pub fn links_between(&self, a: Ref, b: Ref) -> Result<Found> {
         let mut found: Found = Default::default();
-        let mut stack = vec![(a, b)];
+        let mut stack = vec![Pair { a, b, dirs: BOTH }];
         let mut pending: Vec<Pending> = Vec::new();
         let mut segments: Vec<Segment> = Vec::new();
         let mut probes: Vec<Probe> = Vec::new();
@@ -155,9 +169,9 @@ impl Linker<'_> {
             probes.clear();
             let mut taken = 0;
             while taken < WAVE {
-                let Some((x, y)) = stack.pop() else { break };
+                let Some(pair) = stack.pop() else { break };
                 taken += 1;
-                self.classify(x, y, &mut stack, &mut pending, &mut segments, &mut probes);
+                self.classify(pair, &mut stack, &mut pending, &mut segments, &mut probes);
             }
             if segments.is_empty() {
                 continue;
@@ -185,7 +199,7 @@ impl Linker<'_> {
         probes: &[Probe],
         blocked: &[bool],
         found: &mut Found,
-        stack: &mut Vec<(Ref, Ref)>,
+        stack: &mut Vec<Pair>,
         same_group: bool,
     ) {
         let seen = |q: &Probe| q.ray.is_some_and(|ray| !blocked[ray as usize]);
@@ -197,16 +211,24 @@ impl Linker<'_> {
                 found.0.leaf.push(link)
             }
         };
-        let leaf_links = |found: &mut Found, q: &Probe| {
-            let (i, k) = (q.i as usize, q.k as usize);
-            if let Some(f) = Shooter::of(self.samples, self.maps, i).factor_to(self.samples, k) {
-                push_leaf(found, true, LeafLink { r: q.k, s: q.i, f });
+        let leaf_links = |found: &mut Found, i: u32, k: u32| {
+            let (iu, ku) = (i as usize, k as usize);
+            if p.dirs & INTO_B != 0 {
+                if let Some(f) =
+                    Shooter::of(self.samples, self.maps, iu).factor_to(self.samples, ku)
+                {
+                    push_leaf(found, true, LeafLink { r: k, s: i, f });
+                }
             }
-            if let Some(f) = Shooter::of(self.samples, self.maps, k).factor_to(self.samples, i) {
-                push_leaf(found, false, LeafLink { r: q.i, s: q.k, f });
+            if p.dirs & INTO_A != 0 {
+                if let Some(f) =
+                    Shooter::of(self.samples, self.maps, ku).factor_to(self.samples, iu)
+                {
+                    push_leaf(found, false, LeafLink { r: i, s: k, f });
+                }
             }
         };
-        match p.kind {
+        let (exhaustive, one_sided, negligible) = match p.kind {
             Kind::Leaf(ab, ba) => {
                 if seen(&probes[0]) {
                     let (i, k) = (p.a.index() as u32, p.b.index() as u32);
@@ -217,116 +239,149 @@ impl Linker<'_> {
                         push_leaf(found, false, LeafLink { r: i, s: k, f });
                     }
                 }
+                return;
             }
             Kind::Cluster {
                 exhaustive,
                 one_sided,
                 negligible,
-            } => {
-                let rays = probes.iter().filter(|q| q.ray.is_some()).count();
-                let visible = probes.iter().filter(|q| seen(q)).count();
-                let all = rays > 0 && visible == rays;
-                if (exhaustive && rays == 0) || (rays > 0 && visible == 0) {
-                    // Nothing faces, or every facing pair is blocked.
-                } else if all && one_sided {
-                    self.cluster_links(p, [1.0, 1.0], found, same_group);
-                } else if all || negligible {
-                    let conditioned = self.conditioned(p.a, p.b);
-                    if !conditioned && !negligible {
-                        self.split(p.a, p.b, stack);
-                        return;
+            } => (exhaustive, one_sided, negligible),
+        };
+        let rays = probes.iter().filter(|q| q.ray.is_some()).count();
+        let visible = probes.iter().filter(|q| seen(q)).count();
+        let all = rays > 0 && visible == rays;
+        let conditioned = self.conditioned(p.a, p.b);
+        // The formula, scaled by Σ visible exact / Σ formula over the probes (pairs facing
+        // away count 0); near grazing, where the formula is ill-conditioned, by the visible
+        // share of the exact form factors.
+        let factor = |d: usize| {
+            let exact: f64 = probes.iter().filter(|q| seen(q)).map(|q| q.exact[d]).sum();
+            let whole: f64 = if conditioned {
+                probes.iter().map(|q| q.formula[d]).sum()
+            } else {
+                probes.iter().map(|q| q.exact[d]).sum()
+            };
+            if whole > 0.0 {
+                (exact / whole) as f32
+            } else {
+                0.0
+            }
+        };
+        if (exhaustive && rays == 0) || (rays > 0 && visible == 0) {
+            // Nothing faces, or every facing pair is blocked.
+        } else if all && one_sided {
+            self.cluster_links(p, p.dirs, [1.0, 1.0], found, same_group);
+        } else if all && conditioned {
+            // Wholly visible, but some members face away.
+            self.cluster_links(p, p.dirs, [factor(0), factor(1)], found, same_group);
+        } else if exhaustive {
+            // Every member pair is known: the visible ones, sample to sample.
+            for q in probes.iter().filter(|q| seen(q)) {
+                leaf_links(found, q.i, q.k);
+            }
+        } else if negligible && rays > 0 {
+            // Faint and partly visible: a receiver takes the share of the shooter its probes
+            // see, unless it is a cluster something hovers close in front of (a gap its
+            // members may hide in, which would trap the light): that one is refined.
+            let mut to_leaf = 0;
+            let mut refine = 0;
+            for (dir, receiver) in [(INTO_B, p.b), (INTO_A, p.a)] {
+                if p.dirs & dir != 0 {
+                    if receiver.is_leaf() || !self.tree.nodes[receiver.index()].sheltered {
+                        to_leaf |= dir;
+                    } else {
+                        refine |= dir;
                     }
-                    // The formula, scaled by Σ visible exact / Σ formula over the probes (pairs
-                    // facing away count 0); near grazing, where the formula is ill-conditioned,
-                    // by the visible share of the exact form factors.
-                    let factor = |d: usize| {
-                        let exact: f64 =
-                            probes.iter().filter(|q| seen(q)).map(|q| q.exact[d]).sum();
-                        let whole: f64 = if conditioned {
-                            probes.iter().map(|q| q.formula[d]).sum()
-                        } else {
-                            probes.iter().map(|q| q.exact[d]).sum()
-                        };
-                        if whole > 0.0 {
-                            (exact / whole) as f32
-                        } else {
-                            0.0
-                        }
-                    };
-                    self.cluster_links(p, [factor(0), factor(1)], found, same_group);
-                } else if exhaustive {
-                    // Every member pair is known: the visible ones, sample to sample.
-                    for q in probes.iter().filter(|q| seen(q)) {
-                        leaf_links(found, q);
-                    }
-                } else if !(negligible && rays == 0) {
-                    self.split(p.a, p.b, stack);
                 }
             }
+            self.cluster_links(p, to_leaf, [factor(0), factor(1)], found, same_group);
+            if refine != 0 {
+                self.split(
+                    Pair {
+                        dirs: refine,
+                        ..pair_of(p)
+                    },
+                    stack,
+                );
+            }
+        } else {
+            self.split(pair_of(p), stack);
         }
     }
 
-    /// The links a → b and b → a, with their factors.
-    fn cluster_links(&self, p: &Pending, factor: [f32; 2], found: &mut Found, same_group: bool) {
-        let into_b = ClusterLink {
-            r: p.b,
-            s: p.a,
-            factor: factor[0],
-        };
-        let into_a = ClusterLink {
-            r: p.a,
-            s: p.b,
-            factor: factor[1],
-        };
-        if into_b.factor > 0.0 {
+    /// The links of `dirs` (into b, into a) with their factors.
+    fn cluster_links(
+        &self,
+        p: &Pending,
+        dirs: u8,
+        factor: [f32; 2],
+        found: &mut Found,
+        same_group: bool,
+    ) {
+        if dirs & INTO_B != 0 && factor[0] > 0.0 {
+            let link = ClusterLink {
+                r: p.b,
+                s: p.a,
+                factor: factor[0],
+            };
             if same_group {
-                found.0.cluster.push(into_b);
+                found.0.cluster.push(link);
             } else {
-                found.1.cluster.push(into_b);
+                found.1.cluster.push(link);
             }
         }
-        if into_a.factor > 0.0 {
-            found.0.cluster.push(into_a);
+        if dirs & INTO_A != 0 && factor[1] > 0.0 {
+            found.0.cluster.push(ClusterLink {
+                r: p.a,
+                s: p.b,
+                factor: factor[1],
+            });
         }
     }
 
     /// Decides what to do with the pair {a, b}: see the module doc.
     fn classify(
         &self,
-        a: Ref,
-        b: Ref,
-        stack: &mut Vec<(Ref, Ref)>,
+        pair: Pair,
+        stack: &mut Vec<Pair>,
         pending: &mut Vec<Pending>,
         segments: &mut Vec<Segment>,
         probes: &mut Vec<Probe>,
     ) {
         let tree = self.tree;
+        let Pair { a, b, dirs } = pair;
+        let with = |a: Ref, b: Ref| Pair { a, b, dirs };
         if a == b {
             if a.is_leaf() || tree.nodes[a.index()].side != MULTI {
                 // A sample, or samples of one plane: nothing passes between them.
                 return;
             }
             let [x, y] = tree.nodes[a.index()].children;
-            stack.extend([(y, y), (x, y), (x, x)]);
+            stack.extend([with(y, y), with(x, y), with(x, x)]);
             return;
         }
         let (av, bv) = (tree.view(self.samples, a), tree.view(self.samples, b));
         if !a.is_leaf() && holds(&av, &bv) {
-            push_children(tree, a, |c| stack.push((c, b)));
+            push_children(tree, a, |c| stack.push(with(c, b)));
             return;
         }
         if !b.is_leaf() && holds(&bv, &av) {
-            push_children(tree, b, |c| stack.push((a, c)));
+            push_children(tree, b, |c| stack.push(with(a, c)));
             return;
         }
         if a.is_leaf() && b.is_leaf() {
             let (i, k) = (a.index(), b.index());
-            let ab = Shooter::of(self.samples, self.maps, i).factor_to(self.samples, k);
-            let ba = Shooter::of(self.samples, self.maps, k).factor_to(self.samples, i);
+            let ab = (dirs & INTO_B != 0)
+                .then(|| Shooter::of(self.samples, self.maps, i).factor_to(self.samples, k))
+                .flatten();
+            let ba = (dirs & INTO_A != 0)
+                .then(|| Shooter::of(self.samples, self.maps, k).factor_to(self.samples, i))
+                .flatten();
             if ab.is_some() || ba.is_some() {
                 pending.push(Pending {
                     a,
                     b,
+                    dirs,
                     first: probes.len(),
                     probes: 1,
                     kind: Kind::Leaf(ab, ba),
@@ -368,14 +423,24 @@ impl Linker<'_> {
             } else {
                 0.0
             };
-            let weight = (f64::from(bv.rho) * av.power).max(f64::from(av.rho) * bv.power)
-                / std::f64::consts::PI;
+            let into_b = if dirs & INTO_B != 0 {
+                f64::from(bv.rho) * av.power
+            } else {
+                0.0
+            };
+            let into_a = if dirs & INTO_A != 0 {
+                f64::from(av.rho) * bv.power
+            } else {
+                0.0
+            };
+            let weight = into_b.max(into_a) / std::f64::consts::PI;
             if weight * (upper - lower) < self.tolerance {
                 let first = probes.len();
                 let exhaustive = self.probe(&av, &bv, d, segments, probes, (a, b));
                 pending.push(Pending {
                     a,
                     b,
+                    dirs,
                     first,
                     probes: probes.len() - first,
                     kind: Kind::Cluster {
@@ -388,7 +453,7 @@ impl Linker<'_> {
                 return;
             }
         }
-        self.split(a, b, stack);
+        self.split(pair, stack);
     }
 
     /// Whether the links' formula is far from grazing at both ends (the centroids' direction
@@ -403,20 +468,22 @@ impl Linker<'_> {
         av.axis.dot(omega) >= MIN_COS && -bv.axis.dot(omega) >= MIN_COS
     }
 
-    /// Refines a pair by splitting the larger node (a sample cannot be split).
-    fn split(&self, a: Ref, b: Ref, stack: &mut Vec<(Ref, Ref)>) {
+    /// Refines a pair by splitting the larger node (a sample cannot be split); a pair wanted
+    /// in one direction only splits its receiver, so that refinement ends at single receivers.
+    fn split(&self, pair: Pair, stack: &mut Vec<Pair>) {
         let tree = self.tree;
-        let split_a = if a.is_leaf() {
-            false
-        } else if b.is_leaf() {
-            true
-        } else {
-            tree.nodes[a.index()].radius >= tree.nodes[b.index()].radius
+        let Pair { a, b, dirs } = pair;
+        let split_a = match dirs {
+            INTO_A if !a.is_leaf() => true,
+            INTO_B if !b.is_leaf() => false,
+            _ if a.is_leaf() => false,
+            _ if b.is_leaf() => true,
+            _ => tree.nodes[a.index()].radius >= tree.nodes[b.index()].radius,
         };
         if split_a {
-            push_children(tree, a, |c| stack.push((c, b)));
+            push_children(tree, a, |c| stack.push(Pair { a: c, b, dirs }));
         } else {
-            push_children(tree, b, |c| stack.push((a, c)));
+            push_children(tree, b, |c| stack.push(Pair { a, b: c, dirs }));
         }
     }
 
@@ -540,6 +607,14 @@ fn push_children(tree: &Tree, node: Ref, mut push: impl FnMut(Ref)) {
     let [a, b] = tree.nodes[node.index()].children;
     push(b);
     push(a);
+}
+
+fn pair_of(p: &Pending) -> Pair {
+    Pair {
+        a: p.a,
+        b: p.b,
+        dirs: p.dirs,
+    }
 }
 
 /// SplitMix64's finaliser: a well-mixed hash of a 64-bit value.

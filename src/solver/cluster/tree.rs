@@ -10,7 +10,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::coherence::{splitter, Context};
+use super::coherence::{sheltered, splitter, Context};
 use crate::sampling::{Samples, Side};
 
 /// A reference to a tree node or to a single sample (a leaf).
@@ -83,6 +83,8 @@ pub(crate) struct Node {
     pub side: Side,
     /// Whether the node may stand for its members in a link (see `coherence`).
     pub coherent: bool,
+    /// Whether something hovers close in front of it (see `coherence::sheltered`).
+    pub sheltered: bool,
 }
 
 /// Per-sample data the tree and the links use.
@@ -170,7 +172,31 @@ impl Tree {
         for (place, &k) in tree.order.iter().enumerate() {
             tree.place[k as usize] = place as u32;
         }
+        if !tree.nodes.is_empty() {
+            tree.mark_sheltered(cx, 0, true);
+        }
         tree
+    }
+
+    /// Marks node `i`'s subtree: a node is sheltered when its parent is and something hovers
+    /// within a quarter of its radius in front of it.
+    fn mark_sheltered(&mut self, cx: &Context, i: usize, parent: bool) {
+        let node = &self.nodes[i];
+        let here = parent
+            && sheltered(
+                cx,
+                (node.side != MULTI).then_some(node.side),
+                node.axis,
+                node.lo,
+                node.hi,
+                0.25 * node.radius,
+            );
+        self.nodes[i].sheltered = here;
+        for c in self.nodes[i].children {
+            if !c.is_leaf() {
+                self.mark_sheltered(cx, c.index(), here);
+            }
+        }
     }
 
     /// The root (a leaf when there is one sample), if there are samples.
@@ -383,6 +409,7 @@ impl Tree {
             hi: Vec3::ZERO,
             side: MULTI,
             coherent: false,
+            sheltered: true,
         });
         index
     }
@@ -433,6 +460,7 @@ impl Tree {
             hi: parts[0].hi.max(parts[1].hi),
             side: if a.side == b.side { a.side } else { MULTI },
             coherent: false,
+            sheltered: true,
         };
     }
 
