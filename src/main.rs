@@ -111,6 +111,14 @@ enum Command {
         image: PathBuf,
         /// The reference (.exr).
         reference: PathBuf,
+        /// Also write a false-colour picture of the signed error per pixel (PNG, with a legend):
+        /// red where the image is too bright, blue where too dark.
+        #[arg(long)]
+        diff: Option<PathBuf>,
+        /// The error at which the picture's colours saturate, as a fraction of the reference's
+        /// mean (default: the 99th percentile of |error|, rounded up to 1, 2 or 5).
+        #[arg(long)]
+        diff_range: Option<f64>,
     },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
     Samples {
@@ -249,11 +257,17 @@ fn run(args: Args) -> anyhow::Result<()> {
                 png.display()
             );
         }
-        Command::Compare { image, reference } => {
+        Command::Compare {
+            image,
+            reference,
+            diff,
+            diff_range,
+        } => {
             let a = meshlight::Image::read_exr(&image)?;
             let b = meshlight::Image::read_exr(&reference)?;
             let e = meshlight::metrics::compare(&a, &b)?;
             println!("MAE/mean {:.5}", e.mae_over_mean);
+            println!("bias {:+.5} (mean difference / reference mean)", e.bias);
             println!("RMSE/mean {:.5}", e.rmse_over_mean);
             println!("p99 error/mean {:.5}", e.p99_over_mean);
             println!(
@@ -265,6 +279,14 @@ fn run(args: Args) -> anyhow::Result<()> {
                 e.reference_mean[1],
                 e.reference_mean[2]
             );
+            if let Some(path) = diff {
+                let range = cli::plot::write_error_picture(&a, &b, &e, diff_range, &path)?;
+                println!(
+                    "wrote {} (colours saturate at ±{:.3}% of the reference mean)",
+                    path.display(),
+                    100.0 * range
+                );
+            }
         }
         Command::Samples { solve, output } => {
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;

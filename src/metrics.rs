@@ -13,6 +13,9 @@ pub struct ImageError {
     pub rmse_over_mean: f64,
     /// 99th percentile of the per-pixel mean absolute error (over channels) / mean of b.
     pub p99_over_mean: f64,
+    /// Signed bias: (mean of a − mean of b) / mean of b, over pixels and channels; positive
+    /// when `a` is too bright.
+    pub bias: f64,
     /// Per-channel means of a.
     pub mean: [f64; 3],
     /// Per-channel means of b.
@@ -21,15 +24,7 @@ pub struct ImageError {
 
 /// Compares `image` with `reference`; errors if their sizes differ.
 pub fn compare(image: &Image, reference: &Image) -> Result<ImageError> {
-    if (image.width, image.height) != (reference.width, reference.height) {
-        return Err(Error::Option {
-            option: "compare",
-            problem: format!(
-                "image sizes differ: {}x{} vs {}x{}",
-                image.width, image.height, reference.width, reference.height
-            ),
-        });
-    }
+    same_size(image, reference)?;
     let n = image.pixels.len().max(1) as f64;
     let mut mean = [0.0f64; 3];
     let mut reference_mean = [0.0f64; 3];
@@ -58,9 +53,37 @@ pub fn compare(image: &Image, reference: &Image) -> Result<ImageError> {
         mae_over_mean: abs / (3.0 * n) / scale,
         rmse_over_mean: (sq / (3.0 * n)).sqrt() / scale,
         p99_over_mean: p99 / scale,
+        bias: (mean.iter().sum::<f64>() / 3.0 - scale) / scale,
         mean,
         reference_mean,
     })
+}
+
+/// Per pixel, the signed error (a − b, averaged over channels) divided by the reference's
+/// mean: the map a false-colour error image shows. Errors if the sizes differ.
+pub fn signed_error_map(image: &Image, reference: &Image) -> Result<Vec<f32>> {
+    same_size(image, reference)?;
+    let scale = reference.mean();
+    let scale = if scale > 0.0 { scale } else { 1.0 };
+    Ok(image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, b)| (f64::from((*a - *b).element_sum()) / 3.0 / scale) as f32)
+        .collect())
+}
+
+fn same_size(image: &Image, reference: &Image) -> Result<()> {
+    if (image.width, image.height) != (reference.width, reference.height) {
+        return Err(Error::Option {
+            option: "compare",
+            problem: format!(
+                "image sizes differ: {}x{} vs {}x{}",
+                image.width, image.height, reference.width, reference.height
+            ),
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -81,9 +104,10 @@ mod tests {
         let a = image(&[[0.1, 0.2, 0.3], [1.0, 2.0, 3.0]]);
         let e = compare(&a, &a).unwrap();
         assert_eq!(
-            (e.mae_over_mean, e.rmse_over_mean, e.p99_over_mean),
-            (0.0, 0.0, 0.0)
+            (e.mae_over_mean, e.rmse_over_mean, e.p99_over_mean, e.bias),
+            (0.0, 0.0, 0.0, 0.0)
         );
+        assert!(signed_error_map(&a, &a).unwrap().iter().all(|&v| v == 0.0));
     }
 
     #[test]
@@ -98,6 +122,12 @@ mod tests {
             e.mae_over_mean
         );
         assert!((e.rmse_over_mean - (0.75f64 / 6.0).sqrt() / 2.0).abs() < 1e-12);
+        // Mean of a = (4.5 + 9) / 6 = 2.25: 12.5% too bright.
+        assert!((e.bias - 0.125).abs() < 1e-12, "{}", e.bias);
+        let map = signed_error_map(&a, &b).unwrap();
+        assert_eq!(map, vec![0.25, 0.0]);
+        let dark = signed_error_map(&b, &a).unwrap();
+        assert!((dark[0] + 0.5 / 2.25).abs() < 1e-6, "{dark:?}");
     }
 
     #[test]
@@ -107,5 +137,6 @@ mod tests {
             e.to_string().contains("image sizes differ: 1x1 vs 2x1"),
             "{e}"
         );
+        assert!(signed_error_map(&image(&[[0.0; 3]]), &image(&[[0.0; 3], [0.0; 3]])).is_err());
     }
 }

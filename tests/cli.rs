@@ -210,3 +210,67 @@ fn no_epsilon_means_an_automatic_one_that_is_announced() {
         text(&run.stdout)
     );
 }
+
+fn write_pair(dir: &std::path::Path, b: &[[f32; 3]], a: &[[f32; 3]]) -> (String, String) {
+    let image = |p: &[[f32; 3]]| meshlight::Image {
+        width: p.len() as u32,
+        height: 1,
+        pixels: p.iter().map(|&c| glam::Vec3::from(c)).collect(),
+    };
+    let (pa, pb) = (dir.join("a.exr"), dir.join("b.exr"));
+    image(a).write_exr(&pa).unwrap();
+    image(b).write_exr(&pb).unwrap();
+    (
+        pa.to_str().unwrap().to_string(),
+        pb.to_str().unwrap().to_string(),
+    )
+}
+
+#[test]
+fn compare_reports_bias_and_draws_the_signed_error() {
+    let dir = tempfile::tempdir().unwrap();
+    // Reference mean 2; the first pixel is 0.5 too bright on every channel: MAE = 1.5/6 / 2,
+    // bias = (2.25 − 2) / 2, signed error of that pixel 0.5 / 2 = 0.25 of the mean.
+    let (a, b) = write_pair(
+        dir.path(),
+        &[[1.0, 1.0, 1.0], [3.0, 3.0, 3.0]],
+        &[[1.5, 1.5, 1.5], [3.0, 3.0, 3.0]],
+    );
+    let png = dir.path().join("diff.png");
+    let run = meshlight(&["compare", &a, &b, "--diff", png.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let stdout = text(&run.stdout);
+    assert!(stdout.contains("MAE/mean 0.12500"), "{stdout}");
+    assert!(stdout.contains("bias +0.12500"), "{stdout}");
+    // The 99th percentile of |error| is 0.25, rounded up to 0.5: the bright pixel sits
+    // halfway up the red side (the light-red stop), the exact one is white.
+    assert!(stdout.contains("saturate at ±50.000%"), "{stdout}");
+    let picture = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(picture.dimensions(), (2 + 170, 300));
+    assert_eq!(picture.get_pixel(0, 0).0, [244, 165, 130]);
+    assert_eq!(picture.get_pixel(1, 0).0, [247, 247, 247]);
+    // The legend has text: dark pixels right of the image, above the caption's end.
+    let dark = (2..172)
+        .flat_map(|x| (0..300).map(move |y| (x, y)))
+        .filter(|&(x, y)| picture.get_pixel(x, y).0.iter().all(|&c| c < 80))
+        .count();
+    assert!(dark > 200, "{dark} dark legend pixels");
+
+    let identical = meshlight(&["compare", &b, &b]);
+    let stdout = text(&identical.stdout);
+    assert!(stdout.contains("MAE/mean 0.00000"), "{stdout}");
+    assert!(stdout.contains("bias +0.00000"), "{stdout}");
+}
+
+#[test]
+fn compare_refuses_images_of_different_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = write_pair(dir.path(), &[[1.0; 3], [1.0; 3]], &[[1.0; 3]]);
+    let run = meshlight(&["compare", &a, &b]);
+    assert!(!run.status.success());
+    let stderr = text(&run.stderr);
+    assert!(
+        stderr.contains("image sizes differ: 1x1 vs 2x1"),
+        "{stderr}"
+    );
+}

@@ -1,6 +1,7 @@
 //! What the CLI prints: text renderings of the library's reports.
 
 pub mod memory;
+pub mod plot;
 pub mod scale;
 
 use std::fmt::Write;

@@ -1,0 +1,343 @@
+//! Pictures with text: false-colour error images with a legend, and error-against-time plots.
+//! Drawn with plotters into an RGB buffer and written as PNG by `image`. Text needs a TrueType
+//! font, read at run time (Debian's `fonts-dejavu-core`, or the file `MESHLIGHT_FONT` names),
+//! so no system font library is linked.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use anyhow::{anyhow, Context, Result};
+use plotters::coord::combinators::IntoLogRange;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+/// Where the font is looked for when `MESHLIGHT_FONT` is unset.
+const FONT_PATHS: &[&str] = &[
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+];
+
+/// Registers the font once per process; every later call answers the first one's outcome.
+fn font() -> Result<()> {
+    static REGISTERED: OnceLock<std::result::Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            let candidates: Vec<PathBuf> = match std::env::var_os("MESHLIGHT_FONT") {
+                Some(p) => vec![PathBuf::from(p)],
+                None => FONT_PATHS.iter().map(PathBuf::from).collect(),
+            };
+            let Some((path, bytes)) = candidates
+                .iter()
+                .find_map(|p| std::fs::read(p).ok().map(|b| (p, b)))
+            else {
+                return Err(format!(
+                    "no font for the picture's text: looked for {} (install Debian's \
+                     fonts-dejavu-core, or name a .ttf file in MESHLIGHT_FONT)",
+                    candidates
+                        .iter()
+                        .map(|p| p.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            };
+            // plotters keeps fonts for the life of the process.
+            let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+            plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
+                .map_err(|_| format!("{} is not a TrueType font", path.display()))
+        })
+        .clone()
+        .map_err(|e| anyhow!(e))
+}
+
+fn plot_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow!("drawing failed: {e:?}")
+}
+
+/// Writes an RGB buffer as PNG.
+fn write_rgb(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
+    let buffer = image::RgbImage::from_raw(width, height, rgb)
+        .ok_or_else(|| anyhow!("picture buffer of the wrong size"))?;
+    buffer
+        .save_with_format(path, image::ImageFormat::Png)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// A diverging colour map (ColorBrewer's RdBu, reversed): −1 blue, 0 white, +1 red; clamped.
+pub fn diverging(t: f32) -> [u8; 3] {
+    const STOPS: [[f32; 3]; 5] = [
+        [33.0, 102.0, 172.0],
+        [146.0, 197.0, 222.0],
+        [247.0, 247.0, 247.0],
+        [244.0, 165.0, 130.0],
+        [178.0, 24.0, 43.0],
+    ];
+    let t = if t.is_finite() {
+        t.clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = (t + 1.0) * 2.0;
+    let i = (x.floor() as usize).min(3);
+    let f = x - i as f32;
+    let mut out = [0u8; 3];
+    for c in 0..3 {
+        out[c] = (STOPS[i][c] + (STOPS[i + 1][c] - STOPS[i][c]) * f + 0.5) as u8;
+    }
+    out
+}
+
+/// The smallest 1-2-5 step not below `x` (a legend's range).
+pub fn nice_ceiling(x: f64) -> f64 {
+    if !(x > 0.0) || !x.is_finite() {
+        return 0.01;
+    }
+    let decade = 10f64.powf(x.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .find(|&v| v >= x * (1.0 - 1e-9))
+        .unwrap_or(10.0 * decade)
+}
+
+/// A signed fraction as a short percentage: 0.025 → "+2.5%", 0 → "0%".
+pub fn percent_label(fraction: f64) -> String {
+    if fraction == 0.0 {
+        return "0%".to_string();
+    }
+    let text = format!("{:+.3}", 100.0 * fraction);
+    format!("{}%", text.trim_end_matches('0').trim_end_matches('.'))
+}
+
+/// Writes a false-colour picture of signed per-pixel `values` (row-major, `width` × `height`)
+/// with a colour bar from −`range` to +`range` labelled in percent, a title over the bar and
+/// `caption` lines under it.
+pub fn false_colour_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    values: &[f32],
+    range: f64,
+    title: &str,
+    caption: &[String],
+) -> Result<()> {
+    font()?;
+    let legend = 170u32;
+    let (w, h) = (width + legend, height.max(300));
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        for y in 0..height {
+            for x in 0..width {
+                let v = values[(y * width + x) as usize];
+                let [r, g, b] = diverging((f64::from(v) / range) as f32);
+                root.draw_pixel((x as i32, y as i32), &RGBColor(r, g, b))
+                    .map_err(plot_error)?;
+            }
+        }
+        let style = ("sans-serif", 14).into_font();
+        let left = width as i32 + 14;
+        root.draw(&Text::new(title.to_string(), (left, 8), style.clone()))
+            .map_err(plot_error)?;
+        let (top, bar) = (34i32, 180i32);
+        for i in 0..bar {
+            let t = 1.0 - 2.0 * i as f32 / (bar - 1) as f32;
+            let [r, g, b] = diverging(t);
+            root.draw(&Rectangle::new(
+                [(left, top + i), (left + 22, top + i + 1)],
+                RGBColor(r, g, b).filled(),
+            ))
+            .map_err(plot_error)?;
+        }
+        root.draw(&Rectangle::new(
+            [(left, top), (left + 22, top + bar)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(plot_error)?;
+        for k in 0..5 {
+            let value = range * (1.0 - 0.5 * k as f64);
+            let y = top + (bar - 1) * k / 4;
+            root.draw(&PathElement::new(
+                vec![(left + 22, y), (left + 27, y)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(plot_error)?;
+            root.draw(&Text::new(
+                percent_label(value),
+                (left + 31, y - 7),
+                style.clone(),
+            ))
+            .map_err(plot_error)?;
+        }
+        for (i, line) in caption.iter().enumerate() {
+            root.draw(&Text::new(
+                line.clone(),
+                (left, top + bar + 16 + 18 * i as i32),
+                style.clone(),
+            ))
+            .map_err(plot_error)?;
+        }
+        root.present().map_err(plot_error)?;
+    }
+    write_rgb(path, w, h, rgb)
+}
+
+/// Writes `image`'s signed error against `reference` as a false-colour picture; answers the
+/// range its colours saturate at (`range`, or the 99th percentile of |error| rounded up).
+pub fn write_error_picture(
+    image: &meshlight::Image,
+    reference: &meshlight::Image,
+    error: &meshlight::metrics::ImageError,
+    range: Option<f64>,
+    path: &Path,
+) -> Result<f64> {
+    let values = meshlight::metrics::signed_error_map(image, reference)?;
+    let range = match range {
+        Some(r) if r > 0.0 && r.is_finite() => r,
+        Some(r) => return Err(anyhow!("--diff-range must be a positive fraction, not {r}")),
+        None => {
+            let mut magnitudes: Vec<f32> = values.iter().map(|v| v.abs()).collect();
+            magnitudes.sort_unstable_by(f32::total_cmp);
+            let p99 = magnitudes
+                .get(magnitudes.len() * 99 / 100)
+                .copied()
+                .unwrap_or(0.0);
+            nice_ceiling(f64::from(p99))
+        }
+    };
+    let caption = vec![
+        format!("MAE/mean {:.2}%", 100.0 * error.mae_over_mean),
+        format!("bias {}", percent_label(error.bias)),
+        format!("p99 {:.2}%", 100.0 * error.p99_over_mean),
+    ];
+    false_colour_png(
+        path,
+        image.width,
+        image.height,
+        &values,
+        range,
+        "error / mean",
+        &caption,
+    )?;
+    Ok(range)
+}
+
+/// One named series of an error-against-time plot.
+pub struct Series {
+    /// The legend's name.
+    pub name: String,
+    /// (seconds, error) points, in percent of the reference's mean.
+    pub points: Vec<(f64, f64)>,
+    /// Join the points with a line (in the order given).
+    pub line: bool,
+    /// Colour.
+    pub colour: RGBColor,
+}
+
+/// Writes a log-log plot of error (percent) against seconds.
+pub fn error_time_png(path: &Path, title: &str, series: &[Series]) -> Result<()> {
+    font()?;
+    let all: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .filter(|&(t, e)| t > 0.0 && e > 0.0 && t.is_finite() && e.is_finite())
+        .collect();
+    if all.is_empty() {
+        return Err(anyhow!(
+            "nothing to plot: no run has a positive time and error"
+        ));
+    }
+    let (mut t0, mut t1, mut e0, mut e1) = (f64::MAX, 0f64, f64::MAX, 0f64);
+    for &(t, e) in &all {
+        (t0, t1, e0, e1) = (t0.min(t), t1.max(t), e0.min(e), e1.max(e));
+    }
+    let (t0, t1) = (t0 / 1.5, t1 * 1.5);
+    let (e0, e1) = (e0 / 1.5, e1 * 1.5);
+    let (w, h) = (900u32, 600u32);
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d((t0..t1).log_scale(), (e0..e1).log_scale())
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("seconds (log)")
+            .y_desc("MAE / mean, % (log)")
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(plot_error)?;
+        for s in series {
+            let colour = s.colour;
+            let points: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|&(t, e)| t > 0.0 && e > 0.0)
+                .collect();
+            if s.line {
+                chart
+                    .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                    .map_err(plot_error)?;
+            }
+            chart
+                .draw_series(
+                    points
+                        .iter()
+                        .map(|&p| Circle::new(p, if s.line { 4 } else { 3 }, colour.filled())),
+                )
+                .map_err(plot_error)?
+                .label(s.name.clone())
+                .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(plot_error)?;
+        root.present().map_err(plot_error)?;
+    }
+    write_rgb(path, w, h, rgb)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn diverging_map_ends_and_middle() {
+        assert_eq!(diverging(0.0), [247, 247, 247]);
+        assert_eq!(diverging(-1.0), [33, 102, 172]);
+        assert_eq!(diverging(1.0), [178, 24, 43]);
+        assert_eq!(diverging(7.0), diverging(1.0));
+        assert_eq!(diverging(f32::NAN), diverging(0.0));
+        // Halfway between the white and the light red stop.
+        assert_eq!(diverging(0.25), [246, 206, 189]);
+    }
+
+    #[test]
+    fn percent_labels() {
+        assert_eq!(percent_label(0.025), "+2.5%");
+        assert_eq!(percent_label(-0.05), "-5%");
+        assert_eq!(percent_label(0.0), "0%");
+        assert_eq!(percent_label(0.001), "+0.1%");
+    }
+
+    #[test]
+    fn nice_ceilings() {
+        assert_eq!(nice_ceiling(0.013), 0.02);
+        assert_eq!(nice_ceiling(0.02), 0.02);
+        assert!((nice_ceiling(0.031) - 0.05).abs() < 1e-15);
+        assert!((nice_ceiling(0.051) - 0.1).abs() < 1e-15);
+        assert_eq!(nice_ceiling(0.0), 0.01);
+    }
+}
