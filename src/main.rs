@@ -80,6 +80,8 @@ enum Method {
     Meshless,
     /// Unbiased Monte Carlo path tracing: the reference.
     Pathtrace,
+    /// The paper's baseline: progressive radiosity on a regular mesh of square patches.
+    Patches,
 }
 
 #[derive(Subcommand)]
@@ -104,6 +106,9 @@ enum Command {
         /// Path tracing: stop after this many seconds (with fewer samples per pixel).
         #[arg(long)]
         time: Option<f64>,
+        /// Patches: the side of the square patches (default: the solver's ε).
+        #[arg(long)]
+        patch_size: Option<f32>,
     },
     /// Compare an image with a reference: mean absolute error / mean (the paper's measure) and more.
     Compare {
@@ -182,6 +187,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Like other Unix tools, end quietly when the reader of our output goes away
+    // (`meshlight compare a b | head -1`) instead of panicking on the failed write.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of one signal before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     match run(Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -200,6 +212,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             method,
             spp,
             time,
+            patch_size,
         } => {
             let started = std::time::Instant::now();
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
@@ -212,13 +225,14 @@ fn run(args: Args) -> anyhow::Result<()> {
                     threads: options.threads,
                     ..Default::default()
                 };
-                let traced = cli::path_trace_with_progress(&scene, vis.as_ref(), &path_options)?;
+                let traced =
+                    cli::reference::path_trace_with_progress(&scene, vis.as_ref(), &path_options)?;
                 traced.image.write_exr(&output)?;
                 let png = output.with_extension("png");
                 traced.image.write_png(&png, traced.image.auto_exposure())?;
                 print!(
                     "{}",
-                    cli::path_summary(&scene, &traced, &path_options, &options)
+                    cli::reference::path_summary(&scene, &traced, &path_options, &options)
                 );
                 println!(
                     "total {:.2} s{}; wrote {} and {}",
@@ -227,6 +241,34 @@ fn run(args: Args) -> anyhow::Result<()> {
                         ", peak memory {}",
                         cli::memory::human(b)
                     )),
+                    output.display(),
+                    png.display()
+                );
+                return Ok(());
+            }
+            if method == Method::Patches {
+                let patch_options = meshlight::reference::PatchOptions {
+                    patch_size: match patch_size {
+                        Some(h) => h,
+                        None => meshlight::solver::choose_epsilon(&scene, &options)?.0,
+                    },
+                    supersample: supersample.max(1),
+                    seed: options.seed,
+                    threads: options.threads,
+                    ..Default::default()
+                };
+                let solved =
+                    cli::reference::patches_with_progress(&scene, vis.as_ref(), &patch_options)?;
+                solved.image.write_exr(&output)?;
+                let png = output.with_extension("png");
+                solved.image.write_png(&png, solved.image.auto_exposure())?;
+                print!(
+                    "{}",
+                    cli::reference::patch_summary(&scene, &solved, &patch_options, &options)
+                );
+                println!(
+                    "total {:.2} s; wrote {} and {}",
+                    started.elapsed().as_secs_f64(),
                     output.display(),
                     png.display()
                 );

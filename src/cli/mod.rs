@@ -2,6 +2,7 @@
 
 pub mod memory;
 pub mod plot;
+pub mod reference;
 pub mod scale;
 
 use std::fmt::Write;
@@ -380,61 +381,6 @@ fn progress_line(p: &Progress, eta: Option<Duration>) -> String {
             p.round, p.samples
         )
     }
-}
-
-/// Path traces with a progress line on stderr (samples done, time left).
-pub fn path_trace_with_progress(
-    scene: &Scene,
-    vis: &dyn Visibility,
-    options: &meshlight::reference::PathOptions,
-) -> anyhow::Result<meshlight::reference::PathImage> {
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}").expect("valid template"),
-    );
-    bar.enable_steady_tick(Duration::from_millis(200));
-    let start = std::time::Instant::now();
-    let traced = meshlight::reference::path_trace(scene, vis, options, &mut |p| {
-        let f = f64::from(p.done) / f64::from(p.wanted.max(1));
-        let elapsed = start.elapsed().as_secs_f64();
-        let mut left = elapsed * (1.0 - f) / f.max(1e-9);
-        if let Some(limit) = options.seconds {
-            left = left.min((limit - elapsed).max(0.0));
-        }
-        bar.set_message(format!(
-            "path tracing: {} of {} samples per pixel, {:.0}%, about {:.0} s left",
-            p.done,
-            p.wanted,
-            100.0 * f,
-            left.ceil()
-        ));
-    });
-    bar.finish_and_clear();
-    Ok(traced?)
-}
-
-/// The path tracer's summary.
-pub fn path_summary(
-    scene: &Scene,
-    traced: &meshlight::reference::PathImage,
-    path: &meshlight::reference::PathOptions,
-    o: &Options,
-) -> String {
-    format!(
-        "scene {}: {} triangles; backend {}, {} thread(s); path tracing, seed {}\n\
-         path tracer {}x{}: {} samples per pixel, {} rays; mean radiance {:.5}; noise estimate {:.3}% (MAE/mean between the even and odd half-images / 2)\n",
-        scene.path.display(),
-        scene.triangles.len(),
-        o.backend,
-        o.threads,
-        path.seed,
-        traced.image.width,
-        traced.image.height,
-        traced.spp,
-        traced.rays,
-        traced.image.mean(),
-        100.0 * traced.noise
-    )
 }
 
 /// The solve's summary: samples per round, shots, queries, unshot fraction, time per phase.

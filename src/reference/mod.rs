@@ -1,6 +1,9 @@
 //! What meshless results are checked against, sharing no code with the solver: an unbiased
-//! path tracer.
+//! path tracer, and the paper's baseline of radiosity on patches.
 
+mod patches;
 mod path;
+
+pub use patches::{patch_radiosity, PatchImage, PatchOptions, PatchProgress};
 
 pub use path::{path_trace, PathImage, PathOptions, PathProgress};

@@ -1,0 +1,169 @@
+//! The paper's baseline: classical radiosity on a regular mesh of patches. Every surface is cut
+//! into square cells of side H (clipped to the surface), light is shot progressively between
+//! patch centres, and the image interpolates patch radiosities bilinearly per surface. It
+//! shares scene loading, the camera and the visibility backends with the meshless solver, and
+//! nothing else: its own meshing, form factors, direct light and shading.
+
+mod mesh;
+mod render;
+mod solve;
+
+use crate::error::{Error, Result};
+use crate::render::Image;
+use crate::scene::Scene;
+use crate::solver::Control;
+use crate::visibility::workload::LIFT;
+use crate::visibility::Visibility;
+
+/// Patch radiosity settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchOptions {
+    /// Side of the square patches, in scene units.
+    pub patch_size: f32,
+    /// Stop when the unshot power is below this share of the power there was to shoot.
+    pub tolerance: f64,
+    /// Stop after this many shots at most.
+    pub max_shots: u64,
+    /// Refuse meshes of more patches than this (memory and O(N²) time grow with it).
+    pub max_patches: usize,
+    /// Rays per side of each pixel's jittered grid when rendering.
+    pub supersample: u32,
+    /// Seed of the pixel jitter.
+    pub seed: u64,
+    /// Worker threads (results do not depend on them).
+    pub threads: usize,
+}
+
+impl Default for PatchOptions {
+    fn default() -> Self {
+        PatchOptions {
+            patch_size: 0.25,
+            tolerance: 1e-3,
+            max_shots: u64::MAX,
+            max_patches: 200_000,
+            supersample: 2,
+            seed: 1,
+            threads: crate::solver::Options::default().threads,
+        }
+    }
+}
+
+/// How far a patch solve has got.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchProgress {
+    /// Patches in the mesh.
+    pub patches: usize,
+    /// Shots so far.
+    pub shots: u64,
+    /// Unshot power / the power there was to shoot.
+    pub unshot_fraction: f64,
+    /// What the shooting aims at.
+    pub tolerance: f64,
+}
+
+/// A rendered patch solution and what it cost.
+#[derive(Clone, Debug)]
+pub struct PatchImage {
+    /// The camera view.
+    pub image: Image,
+    /// Patches in the mesh.
+    pub patches: usize,
+    /// Shots fired.
+    pub shots: u64,
+    /// Visibility queries in the solve (point lights and pairs of patches).
+    pub queries: u64,
+    /// Unshot power left / the power there was to shoot.
+    pub unshot_fraction: f64,
+    /// Whether the host stopped the solve early.
+    pub stopped: bool,
+    /// Seconds meshing, shooting and rendering.
+    pub seconds: [f64; 3],
+}
+
+/// Meshes, solves and renders the scene's camera view with patches of side
+/// `options.patch_size`; `progress` hears about the shooting now and then and may stop it.
+pub fn patch_radiosity(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &PatchOptions,
+    progress: &mut dyn FnMut(PatchProgress) -> Control,
+) -> Result<PatchImage> {
+    let size = options.patch_size;
+    if !(size.is_finite() && size > 0.0) {
+        return Err(Error::Option {
+            option: "patch-size",
+            problem: format!("must be a positive length, not {size}"),
+        });
+    }
+    if !(options.tolerance.is_finite() && options.tolerance > 0.0 && options.tolerance < 1.0) {
+        return Err(Error::Option {
+            option: "tolerance",
+            problem: format!("must lie in (0, 1), not {}", options.tolerance),
+        });
+    }
+    let estimate = mesh::estimate(scene, size);
+    if estimate > options.max_patches as f64 {
+        return Err(Error::Option {
+            option: "patch-size",
+            problem: format!(
+                "{size} cuts the scene's {:.1} area units into about {estimate:.0} patches, more \
+                 than the {} allowed (the solve grows as the square): choose a larger size",
+                scene.total_area(),
+                options.max_patches
+            ),
+        });
+    }
+    let t = std::time::Instant::now();
+    let mesh = mesh::mesh(scene, size);
+    let meshing = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let lift = LIFT * scene.bounds.diagonal();
+    let mut state: Vec<solve::PatchState> = mesh
+        .patches
+        .iter()
+        .map(|p| solve::PatchState {
+            radiosity: p.emitted,
+            unshot: p.emitted,
+        })
+        .collect();
+    let direct = solve::point_lights(scene, &mesh.patches, &mut state, vis, lift, options.threads)?;
+    let patches = mesh.patches.len();
+    let shooting = solve::shoot(
+        &mesh.patches,
+        state,
+        vis,
+        lift,
+        options.threads,
+        options.tolerance,
+        options.max_shots,
+        &mut |shots, unshot_fraction| {
+            progress(PatchProgress {
+                patches,
+                shots,
+                unshot_fraction,
+                tolerance: options.tolerance,
+            })
+        },
+    )?;
+    let solving = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let radiosity: Vec<_> = shooting.state.iter().map(|s| s.radiosity).collect();
+    let image = render::render(
+        scene,
+        &mesh,
+        &radiosity,
+        vis,
+        options.supersample,
+        options.seed,
+        options.threads,
+    )?;
+    Ok(PatchImage {
+        image,
+        patches,
+        shots: shooting.shots,
+        queries: direct + shooting.queries,
+        unshot_fraction: shooting.unshot_fraction,
+        stopped: shooting.stopped,
+        seconds: [meshing, solving, t.elapsed().as_secs_f64()],
+    })
+}
