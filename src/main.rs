@@ -30,7 +30,7 @@ struct SolveArgs {
 }
 
 /// Every solver setting but the scene and ε.
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 struct Knobs {
     /// Start from a preset: preview, default or final.
     #[arg(long, default_value = "default")]
@@ -124,6 +124,44 @@ enum Command {
         /// mean (default: the 99th percentile of |error|, rounded up to 1, 2 or 5).
         #[arg(long)]
         diff_range: Option<f64>,
+    },
+    /// Run a grid of settings against a reference image: a CSV of time and error per run, and
+    /// a plot of error against time with the Pareto front and the path tracer's curve.
+    Sweep {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// The reference image (.exr), e.g. from `render --method pathtrace` with many samples;
+        /// every run renders at its size.
+        #[arg(long)]
+        reference: PathBuf,
+        /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
+        /// Keys: preset, epsilon, zeta, alpha, rounds, light-samples, tolerance, max-shots,
+        /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
+        /// supersample, patch-size, spp.
+        #[arg(long, required = true, value_parser = cli::sweep::parse_vary)]
+        vary: Vec<(String, Vec<String>)>,
+        /// How each run computes its image.
+        #[arg(long, default_value = "meshless")]
+        method: Method,
+        /// Rays per side on edge pixels (meshless) or per pixel (patches).
+        #[arg(long, default_value_t = 4)]
+        supersample: u32,
+        /// Patches: the side of the square patches (default: the solver's ε).
+        #[arg(long)]
+        patch_size: Option<f32>,
+        /// Path tracing runs: samples per pixel.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Output prefix: writes PREFIX.csv and PREFIX.png.
+        #[arg(long, default_value = "sweep")]
+        out: PathBuf,
+        /// Leave out the path tracer's curve.
+        #[arg(long)]
+        no_pathtrace: bool,
+        /// The path tracer's curve doubles samples per pixel from 2 up to this many, or until a
+        /// render takes twice as long as the slowest run.
+        #[arg(long, default_value_t = 4096)]
+        max_spp: u32,
     },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
     Samples {
@@ -329,6 +367,37 @@ fn run(args: Args) -> anyhow::Result<()> {
                     100.0 * range
                 );
             }
+        }
+        Command::Sweep {
+            solve,
+            reference,
+            vary,
+            method,
+            supersample,
+            patch_size,
+            spp,
+            out,
+            no_pathtrace,
+            max_spp,
+        } => {
+            let scene = load(&solve.scene)?;
+            let reference = meshlight::Image::read_exr(&reference)?;
+            cli::sweep::run(
+                &scene,
+                &reference,
+                &cli::sweep::Sweep {
+                    vary,
+                    method,
+                    epsilon: solve.epsilon,
+                    knobs: solve.knobs,
+                    supersample,
+                    patch_size,
+                    spp,
+                    out,
+                    pathtrace_curve: !no_pathtrace,
+                    max_spp,
+                },
+            )?;
         }
         Command::Samples { solve, output } => {
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;

@@ -274,3 +274,104 @@ fn compare_refuses_images_of_different_sizes() {
         "{stderr}"
     );
 }
+
+#[test]
+fn sweep_writes_a_row_per_setting_and_a_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    // A 16×16 path-traced reference of the furnace box: every run renders at its size.
+    let mut scene = meshlight::Scene::load("scenes/box/scene.toml").unwrap();
+    scene.camera.width = 16;
+    scene.camera.height = 16;
+    let vis = meshlight::Backend::Bvh.build(&scene).unwrap();
+    let traced = meshlight::reference::path_trace(
+        &scene,
+        vis.as_ref(),
+        &meshlight::reference::PathOptions {
+            spp: 1024,
+            ..Default::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    let reference = dir.path().join("ref.exr");
+    traced.image.write_exr(&reference).unwrap();
+    let prefix = dir.path().join("s");
+    let run = meshlight(&[
+        "sweep",
+        "scenes/box/scene.toml",
+        "--reference",
+        reference.to_str().unwrap(),
+        "--vary",
+        "epsilon=0.3,0.2",
+        "--vary",
+        "rounds=0,1",
+        "--max-spp",
+        "8",
+        "--backend",
+        "bvh",
+        "--out",
+        prefix.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let csv = std::fs::read_to_string(prefix.with_extension("csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert!(
+        lines[0].starts_with("method,epsilon,rounds,spp,samples,"),
+        "{}",
+        lines[0]
+    );
+    let meshless: Vec<Vec<&str>> = lines[1..]
+        .iter()
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|f| f[0] == "meshless")
+        .collect();
+    let settings: Vec<(&str, &str)> = meshless.iter().map(|f| (f[1], f[2])).collect();
+    assert_eq!(
+        settings,
+        [("0.3", "0"), ("0.3", "1"), ("0.2", "0"), ("0.2", "1")]
+    );
+    let columns = lines[0].split(',').count();
+    for f in &meshless {
+        assert_eq!(f.len(), columns);
+        let samples: usize = f[4].parse().unwrap();
+        assert!(samples > 10, "{f:?}");
+        // The furnace is uniform: every run lands within the reference's noise (about 0.7%) of it.
+        let mae: f64 = f[columns - 5].parse().unwrap();
+        assert!(mae > 0.0 && mae < 0.02, "{f:?}");
+    }
+    // Finer spacing, more samples.
+    let samples = |i: usize| meshless[i][4].parse::<usize>().unwrap();
+    assert!(samples(2) > samples(0));
+    let spp: Vec<&str> = lines[1..]
+        .iter()
+        .filter(|l| l.starts_with("pathtrace"))
+        .map(|l| l.split(',').nth(3).unwrap())
+        .collect();
+    assert!(!spp.is_empty() && spp.len() <= 3, "{spp:?}");
+    assert_eq!(spp[0], "2");
+    let png = image::open(prefix.with_extension("png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (900, 600));
+    let coloured = png
+        .pixels()
+        .filter(|p| p.0[0] > 150 && p.0[1] < 60 && p.0[2] < 80)
+        .count();
+    assert!(
+        coloured > 100,
+        "the path tracer's red curve: {coloured} pixels"
+    );
+
+    let bad = meshlight(&[
+        "sweep",
+        "scenes/box/scene.toml",
+        "--reference",
+        reference.to_str().unwrap(),
+        "--vary",
+        "zeta=fast",
+    ]);
+    assert!(!bad.status.success());
+    assert!(
+        text(&bad.stderr).contains("--vary zeta: 'fast' is not a valid value"),
+        "{}",
+        text(&bad.stderr)
+    );
+}

@@ -4,6 +4,7 @@ pub mod memory;
 pub mod plot;
 pub mod reference;
 pub mod scale;
+pub mod sweep;
 
 use std::fmt::Write;
 use std::time::Duration;
@@ -275,13 +276,19 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
     s
 }
 
-/// Options from a preset, the scene file and the command line, in that order of precedence.
+/// The scene, and options from a preset, the scene file and the command line, in that order
+/// of precedence.
 pub fn solve_setup(
     scene: &std::path::Path,
     epsilon: Option<f32>,
     args: &crate::Knobs,
 ) -> anyhow::Result<(Scene, Options)> {
     let scene = crate::load(scene)?;
+    Ok((scene, options_from(epsilon, args)?))
+}
+
+/// Options from a preset and the command line's knobs.
+pub fn options_from(epsilon: Option<f32>, args: &crate::Knobs) -> anyhow::Result<Options> {
     let mut o = match args.preset.as_str() {
         "preview" => Options::preview(),
         "default" => Options::default(),
@@ -301,7 +308,7 @@ pub fn solve_setup(
     o.backend = args.backend.unwrap_or(o.backend);
     o.threads = args.threads.unwrap_or(o.threads).max(1);
     o.seed = args.seed.unwrap_or(o.seed);
-    Ok((scene, o))
+    Ok(o)
 }
 
 /// Solves with a progress line on stderr: the phase, how far it has got, and an estimate of

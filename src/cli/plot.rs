@@ -89,7 +89,7 @@ pub fn diverging(t: f32) -> [u8; 3] {
 
 /// The smallest 1-2-5 step not below `x` (a legend's range).
 pub fn nice_ceiling(x: f64) -> f64 {
-    if !(x > 0.0) || !x.is_finite() {
+    if x.is_nan() || x <= 0.0 || x.is_infinite() {
         return 0.01;
     }
     let decade = 10f64.powf(x.log10().floor());
@@ -270,6 +270,7 @@ pub fn error_time_png(path: &Path, title: &str, series: &[Series]) -> Result<()>
             .configure_mesh()
             .x_desc("seconds (log)")
             .y_desc("MAE / mean, % (log)")
+            .light_line_style(RGBColor(238, 238, 238))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(plot_error)?;

@@ -1,0 +1,548 @@
+//! `meshlight sweep`: solve a scene over a grid of settings, measure each run's time and its
+//! error against a reference image, and write a CSV and a plot of error against time with
+//! the Pareto front marked and the path tracer's curve (doubling samples per pixel) beside.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context, Result};
+use meshlight::metrics::ImageError;
+use meshlight::solver::Options;
+use meshlight::{Backend, Image, Scene, Visibility};
+use plotters::style::RGBColor;
+
+use super::plot::{error_time_png, Series};
+use crate::Method;
+
+/// The settings `--vary` knows, as the command line spells them.
+const KEYS: &[&str] = &[
+    "preset",
+    "epsilon",
+    "zeta",
+    "alpha",
+    "rounds",
+    "light-samples",
+    "tolerance",
+    "max-shots",
+    "max-samples",
+    "cluster-threshold",
+    "exact-visibility",
+    "backend",
+    "threads",
+    "seed",
+    "supersample",
+    "patch-size",
+    "spp",
+];
+
+/// What a sweep runs.
+pub struct Sweep {
+    /// The settings to vary and their values, in the order given.
+    pub vary: Vec<(String, Vec<String>)>,
+    /// How each run makes its image.
+    pub method: Method,
+    /// ε from the command line, for every run that does not vary it.
+    pub epsilon: Option<f32>,
+    /// The fixed knobs from the command line.
+    pub knobs: crate::Knobs,
+    /// Rays per side on edge pixels (meshless) or per pixel (patches).
+    pub supersample: u32,
+    /// Patch side (patches; default the solver's ε).
+    pub patch_size: Option<f32>,
+    /// Samples per pixel (pathtrace).
+    pub spp: u32,
+    /// Output prefix: PREFIX.csv and PREFIX.png.
+    pub out: PathBuf,
+    /// Add the path tracer's curve (doubling spp) to the CSV and the plot.
+    pub pathtrace_curve: bool,
+    /// The curve's largest samples per pixel.
+    pub max_spp: u32,
+}
+
+/// Parses `key=v1,v2,...`.
+pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String> {
+    let (key, values) = s
+        .split_once('=')
+        .ok_or_else(|| format!("'{s}' is not key=value1,value2,..."))?;
+    let key = key.trim().replace('_', "-");
+    if !KEYS.contains(&key.as_str()) {
+        return Err(format!(
+            "unknown setting '{key}' (known: {})",
+            KEYS.join(", ")
+        ));
+    }
+    let values: Vec<String> = values
+        .split(',')
+        .map(|v| v.trim().to_string())
+        .filter(|v| !v.is_empty())
+        .collect();
+    if values.is_empty() {
+        return Err(format!("'{s}' gives {key} no values"));
+    }
+    Ok((key, values))
+}
+
+/// One run's settings beyond the solver's options.
+#[derive(Clone, Copy)]
+struct Extra {
+    supersample: u32,
+    patch_size: Option<f32>,
+    spp: u32,
+}
+
+fn value<T: FromStr>(key: &str, v: &str) -> Result<T> {
+    v.parse()
+        .map_err(|_| anyhow!("--vary {key}: '{v}' is not a valid value"))
+}
+
+/// Sets one varied setting (`preset` is applied before, when the options are made).
+fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
+    match key {
+        "preset" => {}
+        "epsilon" => o.epsilon = Some(value(key, v)?),
+        "zeta" => o.zeta = value(key, v)?,
+        "alpha" => o.alpha = value(key, v)?,
+        "rounds" => o.rounds = value(key, v)?,
+        "light-samples" => o.light_samples = value(key, v)?,
+        "tolerance" => o.tolerance = value(key, v)?,
+        "max-shots" => o.max_shots = Some(value(key, v)?),
+        "max-samples" => o.max_samples = value(key, v)?,
+        "cluster-threshold" => o.cluster_threshold = value(key, v)?,
+        "exact-visibility" => o.exact_visibility = value(key, v)?,
+        "backend" => o.backend = Backend::from_str(v).map_err(|e| anyhow!("--vary {key}: {e}"))?,
+        "threads" => o.threads = value::<usize>(key, v)?.max(1),
+        "seed" => o.seed = value(key, v)?,
+        "supersample" => extra.supersample = value::<u32>(key, v)?.max(1),
+        "patch-size" => extra.patch_size = Some(value(key, v)?),
+        "spp" => extra.spp = value(key, v)?,
+        other => bail!("--vary: unknown setting '{other}'"),
+    }
+    Ok(())
+}
+
+/// Every combination of the varied values, the first key varying slowest.
+fn grid(vary: &[(String, Vec<String>)]) -> Vec<Vec<(String, String)>> {
+    let mut points: Vec<Vec<(String, String)>> = vec![Vec::new()];
+    for (key, values) in vary {
+        points = points
+            .into_iter()
+            .flat_map(|p| {
+                values.iter().map(move |v| {
+                    let mut q = p.clone();
+                    q.push((key.clone(), v.clone()));
+                    q
+                })
+            })
+            .collect();
+    }
+    points
+}
+
+/// One measured run.
+struct Row {
+    method: &'static str,
+    settings: Vec<String>,
+    spp: Option<u32>,
+    /// Samples (meshless) or patches.
+    samples: usize,
+    shots: u64,
+    queries: u64,
+    /// Place (or mesh), areas, direct, links, shoot, render.
+    seconds: [f64; 6],
+    total: f64,
+    error: ImageError,
+    pareto: bool,
+}
+
+/// Runs the sweep, printing a line per run, and writes PREFIX.csv and PREFIX.png.
+pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
+    let mut scene = scene.clone();
+    scene.camera.width = reference.width;
+    scene.camera.height = reference.height;
+    if let Some(problem) = scene.camera.problem() {
+        bail!("the reference's size does not make a camera: {problem}");
+    }
+    // Check every setting before the first run.
+    let points = grid(&sweep.vary);
+    let mut runs = Vec::with_capacity(points.len());
+    for point in &points {
+        let mut knobs = sweep.knobs.clone();
+        for (k, v) in point {
+            if k == "preset" {
+                knobs.preset = v.clone();
+            }
+        }
+        let mut options = super::options_from(sweep.epsilon, &knobs)?;
+        let mut extra = Extra {
+            supersample: sweep.supersample.max(1),
+            patch_size: sweep.patch_size,
+            spp: sweep.spp,
+        };
+        for (k, v) in point {
+            apply(k, v, &mut options, &mut extra)?;
+        }
+        runs.push((point, options, extra));
+    }
+    let keys: Vec<&str> = sweep.vary.iter().map(|(k, _)| k.as_str()).collect();
+    println!(
+        "sweep of {} on {} at {}x{}: {} run(s) of {}",
+        keys.join(" × "),
+        scene.path.display(),
+        reference.width,
+        reference.height,
+        runs.len(),
+        method_name(sweep.method)
+    );
+    let mut backends: HashMap<Backend, Box<dyn Visibility>> = HashMap::new();
+    let mut rows = Vec::new();
+    for (i, (point, options, extra)) in runs.iter().enumerate() {
+        let vis = built(&mut backends, &scene, options.backend)?;
+        let mut row = measure(&scene, vis, reference, sweep.method, options, extra)?;
+        row.settings = point.iter().map(|(_, v)| v.clone()).collect();
+        println!(
+            "run {}/{}: {}: {} {}, {:.3} s, MAE/mean {:.3}%, bias {:+.3}%",
+            i + 1,
+            runs.len(),
+            point
+                .iter()
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect::<Vec<_>>()
+                .join(" "),
+            row.samples,
+            if sweep.method == Method::Patches {
+                "patches"
+            } else {
+                "samples"
+            },
+            row.total,
+            100.0 * row.error.mae_over_mean,
+            100.0 * row.error.bias
+        );
+        rows.push(row);
+    }
+    mark_pareto(&mut rows);
+    let mut curve = Vec::new();
+    if sweep.pathtrace_curve && sweep.method != Method::Pathtrace {
+        let slowest = rows.iter().map(|r| r.total).fold(0.0, f64::max);
+        let budget = (2.0 * slowest).max(1.0);
+        let options = super::options_from(sweep.epsilon, &sweep.knobs)?;
+        let vis = built(&mut backends, &scene, options.backend)?;
+        let mut spp = 2;
+        while spp <= sweep.max_spp.max(2) {
+            let extra = Extra {
+                supersample: 1,
+                patch_size: None,
+                spp,
+            };
+            let row = measure(&scene, vis, reference, Method::Pathtrace, &options, &extra)?;
+            println!(
+                "path tracer {spp} spp: {:.3} s, MAE/mean {:.3}%, bias {:+.3}%",
+                row.total,
+                100.0 * row.error.mae_over_mean,
+                100.0 * row.error.bias
+            );
+            let total = row.total;
+            curve.push(row);
+            if total > budget {
+                break;
+            }
+            spp *= 2;
+        }
+    }
+    let csv = sweep.out.with_extension("csv");
+    std::fs::write(&csv, to_csv(&keys, &rows, &curve))
+        .with_context(|| format!("cannot write {}", csv.display()))?;
+    let png = sweep.out.with_extension("png");
+    plot(&png, &scene, sweep.method, &rows, &curve)?;
+    println!("Pareto front (no run both faster and more accurate):");
+    let mut front: Vec<&Row> = rows.iter().filter(|r| r.pareto).collect();
+    front.sort_by(|a, b| a.total.total_cmp(&b.total));
+    for r in front {
+        let settings: Vec<String> = keys
+            .iter()
+            .zip(&r.settings)
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        println!(
+            "  {}: {:.3} s, MAE/mean {:.3}%",
+            settings.join(" "),
+            r.total,
+            100.0 * r.error.mae_over_mean
+        );
+    }
+    println!("wrote {} and {}", csv.display(), png.display());
+    Ok(())
+}
+
+/// The backend `b` over the scene, built once per sweep.
+fn built<'a>(
+    cache: &'a mut HashMap<Backend, Box<dyn Visibility>>,
+    scene: &Scene,
+    b: Backend,
+) -> Result<&'a dyn Visibility> {
+    if let std::collections::hash_map::Entry::Vacant(e) = cache.entry(b) {
+        e.insert(b.build(scene)?);
+    }
+    Ok(cache[&b].as_ref())
+}
+
+fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::Meshless => "meshless",
+        Method::Pathtrace => "pathtrace",
+        Method::Patches => "patches",
+    }
+}
+
+/// Runs one setting and measures it against the reference.
+fn measure(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    reference: &Image,
+    method: Method,
+    options: &Options,
+    extra: &Extra,
+) -> Result<Row> {
+    let started = Instant::now();
+    let mut row = Row {
+        method: method_name(method),
+        settings: Vec::new(),
+        spp: None,
+        samples: 0,
+        shots: 0,
+        queries: 0,
+        seconds: [0.0; 6],
+        total: 0.0,
+        error: meshlight::metrics::compare(reference, reference)?,
+        pareto: false,
+    };
+    let image = match method {
+        Method::Meshless => {
+            let solution = super::solve_with_progress(scene, vis, options)?;
+            for r in &solution.rounds {
+                let s = r.seconds;
+                for (acc, v) in row
+                    .seconds
+                    .iter_mut()
+                    .zip([s.sampling, s.areas, s.direct, s.links, s.shooting])
+                {
+                    *acc += v;
+                }
+                row.shots += r.shooting.shots;
+                row.queries += r.shooting.queries + r.direct_queries;
+            }
+            row.samples = solution.samples.len();
+            let t = Instant::now();
+            let (image, _) = meshlight::render(
+                scene,
+                &solution,
+                vis,
+                &meshlight::RenderOptions {
+                    threads: options.threads,
+                    supersample: extra.supersample,
+                },
+            )?;
+            row.seconds[5] = t.elapsed().as_secs_f64();
+            image
+        }
+        Method::Patches => {
+            let patch = meshlight::reference::PatchOptions {
+                patch_size: match extra.patch_size {
+                    Some(h) => h,
+                    None => meshlight::solver::choose_epsilon(scene, options)?.0,
+                },
+                supersample: extra.supersample,
+                seed: options.seed,
+                threads: options.threads,
+                ..Default::default()
+            };
+            let solved = super::reference::patches_with_progress(scene, vis, &patch)?;
+            row.samples = solved.patches;
+            row.shots = solved.shots;
+            row.queries = solved.queries;
+            row.seconds[0] = solved.seconds[0];
+            row.seconds[4] = solved.seconds[1];
+            row.seconds[5] = solved.seconds[2];
+            solved.image
+        }
+        Method::Pathtrace => {
+            let path = meshlight::reference::PathOptions {
+                spp: extra.spp,
+                seed: options.seed,
+                threads: options.threads,
+                ..Default::default()
+            };
+            let traced = super::reference::path_trace_with_progress(scene, vis, &path)?;
+            row.spp = Some(traced.spp);
+            row.queries = traced.rays;
+            row.seconds[5] = started.elapsed().as_secs_f64();
+            traced.image
+        }
+    };
+    row.total = started.elapsed().as_secs_f64();
+    row.error = meshlight::metrics::compare(&image, reference)?;
+    Ok(row)
+}
+
+/// Marks the runs no other run beats on both time and error.
+fn mark_pareto(rows: &mut [Row]) {
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| (r.total, r.error.mae_over_mean))
+        .collect();
+    for (i, r) in rows.iter_mut().enumerate() {
+        let (t, e) = points[i];
+        r.pareto = !points
+            .iter()
+            .enumerate()
+            .any(|(j, &(u, f))| j != i && u <= t && f <= e && (u < t || f < e));
+    }
+}
+
+fn to_csv(keys: &[&str], rows: &[Row], curve: &[Row]) -> String {
+    let mut out = String::from("method");
+    for k in keys {
+        let _ = write!(out, ",{k}");
+    }
+    out.push_str(
+        ",spp,samples,shots,queries,place_s,areas_s,direct_s,links_s,shoot_s,render_s,total_s,\
+         mae_over_mean,rmse_over_mean,p99_over_mean,bias,pareto\n",
+    );
+    for r in rows.iter().chain(curve) {
+        out.push_str(r.method);
+        for i in 0..keys.len() {
+            let _ = write!(out, ",{}", r.settings.get(i).map_or("", String::as_str));
+        }
+        let _ = write!(
+            out,
+            ",{},{},{},{}",
+            r.spp.map_or(String::new(), |s| s.to_string()),
+            r.samples,
+            r.shots,
+            r.queries
+        );
+        for s in r.seconds {
+            let _ = write!(out, ",{s:.4}");
+        }
+        let _ = writeln!(
+            out,
+            ",{:.4},{:.6},{:.6},{:.6},{:+.6},{}",
+            r.total,
+            r.error.mae_over_mean,
+            r.error.rmse_over_mean,
+            r.error.p99_over_mean,
+            r.error.bias,
+            u8::from(r.pareto)
+        );
+    }
+    out
+}
+
+fn plot(path: &Path, scene: &Scene, method: Method, rows: &[Row], curve: &[Row]) -> Result<()> {
+    let percent = |r: &Row| (r.total, 100.0 * r.error.mae_over_mean);
+    let mut front: Vec<(f64, f64)> = rows.iter().filter(|r| r.pareto).map(percent).collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut series = vec![
+        Series {
+            name: format!("{} runs", method_name(method)),
+            points: rows.iter().map(percent).collect(),
+            line: false,
+            colour: RGBColor(150, 150, 150),
+        },
+        Series {
+            name: "Pareto front".to_string(),
+            points: front,
+            line: true,
+            colour: RGBColor(33, 102, 172),
+        },
+    ];
+    if !curve.is_empty() {
+        series.push(Series {
+            name: "path tracer (doubling spp)".to_string(),
+            points: curve.iter().map(percent).collect(),
+            line: true,
+            colour: RGBColor(178, 24, 43),
+        });
+    }
+    let name = scene.path.parent().and_then(|p| p.file_name()).map_or_else(
+        || scene.path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    error_time_png(path, &format!("{name}: error against time"), &series)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vary_parses_and_refuses() {
+        assert_eq!(
+            parse_vary("epsilon=0.3, 0.2").unwrap(),
+            (
+                "epsilon".to_string(),
+                vec!["0.3".to_string(), "0.2".to_string()]
+            )
+        );
+        assert_eq!(parse_vary("light_samples=4").unwrap().0, "light-samples");
+        assert!(parse_vary("colour=red")
+            .unwrap_err()
+            .contains("unknown setting 'colour'"));
+        assert!(parse_vary("zeta").unwrap_err().contains("key=value1"));
+        assert!(parse_vary("zeta=").unwrap_err().contains("no values"));
+    }
+
+    fn row(total: f64, mae: f64) -> Row {
+        let image = Image {
+            width: 1,
+            height: 1,
+            pixels: vec![glam::Vec3::ONE],
+        };
+        let mut error = meshlight::metrics::compare(&image, &image).unwrap();
+        error.mae_over_mean = mae;
+        Row {
+            method: "meshless",
+            settings: Vec::new(),
+            spp: None,
+            samples: 0,
+            shots: 0,
+            queries: 0,
+            seconds: [0.0; 6],
+            total,
+            error,
+            pareto: false,
+        }
+    }
+
+    #[test]
+    fn the_pareto_front_holds_the_runs_nothing_beats() {
+        // (1 s, 5%) and (3 s, 1%) are beaten by nothing; (2 s, 6%) by the first; (4 s, 1%)
+        // ties the second on error but is slower; (3 s, 1%) twice: neither beats the other.
+        let mut rows = vec![
+            row(1.0, 0.05),
+            row(2.0, 0.06),
+            row(3.0, 0.01),
+            row(4.0, 0.01),
+            row(3.0, 0.01),
+        ];
+        mark_pareto(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
+        assert_eq!(front, [true, false, true, false, true]);
+    }
+
+    #[test]
+    fn the_grid_is_every_combination_first_key_slowest() {
+        let g = grid(&[
+            ("a".into(), vec!["1".into(), "2".into()]),
+            ("b".into(), vec!["x".into(), "y".into(), "z".into()]),
+        ]);
+        let flat: Vec<String> = g
+            .iter()
+            .map(|p| p.iter().map(|(_, v)| v.as_str()).collect::<String>())
+            .collect();
+        assert_eq!(flat, ["1x", "1y", "1z", "2x", "2y", "2z"]);
+    }
+}
