@@ -82,6 +82,23 @@ fn albedo_099_with_few_shots_stops_and_says_how_much_is_left() {
         // What was shot is a lower bound: below the converged answer, above the direct light.
         let l = s.radiosity[0].x / std::f64::consts::PI;
         assert!(l > 0.1 * 1.99 && l < 10.0, "{l}");
+        // And what is left is told right: unshot radiosity U still brings ρU + ρ²U + … =
+        // U·ρ/(1 − ρ), so B + 99·U (area-weighted means) is the converged π·Ke/(1 − ρ) = 10π.
+        let area: f64 = s.samples.area.iter().sum();
+        let mean = |v: &[glam::DVec3]| {
+            v.iter()
+                .zip(&s.samples.area)
+                .map(|(b, a)| b.x * a)
+                .sum::<f64>()
+                / area
+        };
+        let predicted = (mean(&s.radiosity) + 99.0 * mean(&s.unshot)) / std::f64::consts::PI;
+        assert!(
+            (predicted - 10.0).abs() < 0.02 * 10.0,
+            "threshold {threshold}: shot {:.3} + left {:.3} = {predicted:.3}, not 10",
+            mean(&s.radiosity) / std::f64::consts::PI,
+            99.0 * mean(&s.unshot) / std::f64::consts::PI
+        );
     }
 }
 

@@ -62,6 +62,27 @@ fn furnace_holds_with_the_hierarchy_and_without_it() {
                 worst_sample < 0.01 && worst_pixel < 0.01,
                 "{backend}, threshold {threshold}: worst sample {worst_sample:.4}, pixel {worst_pixel:.4}"
             );
+            // B = Ke/(1 − Kd) holds by construction once rows are scaled to sum to 1; the
+            // transfer itself must already be close: every closed row's raw sum (before the
+            // scaling, target 1 here as every emitter reflects) within 1 ± 2% for the flat
+            // solver (measured 0.997..1.013). The hierarchy's receiver field is first order,
+            // and a tangent overestimates a concave field: at face centres, where irradiance
+            // peaks, rows reach 1.021 (median 1.008), hence 2.5% for it.
+            let closed: Vec<usize> = (0..s.samples.len()).filter(|&k| s.closed[k]).collect();
+            assert!(
+                closed.len() > s.samples.len() * 9 / 10,
+                "{} closed",
+                closed.len()
+            );
+            let (lo, hi) = closed
+                .iter()
+                .map(|&k| 1.0 / f64::from(s.row_scale[k]))
+                .fold((f64::MAX, 0.0f64), |(lo, hi), r| (lo.min(r), hi.max(r)));
+            let allowed = if threshold == 0.0 { 0.02 } else { 0.025 };
+            assert!(
+                lo > 1.0 - allowed && hi < 1.0 + allowed,
+                "{backend}, threshold {threshold}: raw row sums span {lo:.4}..{hi:.4}"
+            );
         }
     }
 }

@@ -59,7 +59,45 @@ fn exr_round_trip_and_png() {
     let png = dir.path().join("room.png");
     image.write_png(&png, image.auto_exposure()).unwrap();
     assert!(std::fs::metadata(&png).unwrap().len() > 1000);
-    // Pixel (0, 0) is the top-left: the top of the room image is ceiling, the bottom floor.
+}
+
+#[test]
+fn the_image_is_upright_and_not_mirrored() {
+    // The camera looks along +z with up +y, so its right is −x: the red wall (x = 5.5) shows
+    // on the left, the green one (x = 0) on the right, and the light under the ceiling in the
+    // top half; pixel (0, 0) is the top-left.
+    let scene = Scene::load(shipped("room")).unwrap();
+    let image = solve_and_render(
+        &scene,
+        meshlight::Backend::default_backend(),
+        Options::preview(),
+    );
     let (w, h) = (image.width as usize, image.height as usize);
-    assert!(image.pixels[0].length() > 0.0 && image.pixels[w * h - 1].length() > 0.0);
+    let band = |x0: usize, x1: usize| -> glam::Vec3 {
+        let mut sum = glam::Vec3::ZERO;
+        for y in h * 2 / 5..h * 3 / 5 {
+            for x in x0..x1 {
+                sum += image.pixels[y * w + x];
+            }
+        }
+        sum
+    };
+    let (left, right) = (band(0, w / 12), band(w - w / 12, w));
+    assert!(left.x > 3.0 * left.y, "left band {left}: not the red wall");
+    assert!(
+        right.y > 2.0 * right.x,
+        "right band {right}: not the green wall"
+    );
+    let brightest = (0..w * h)
+        .max_by(|&a, &b| {
+            image.pixels[a]
+                .length()
+                .total_cmp(&image.pixels[b].length())
+        })
+        .unwrap();
+    assert!(
+        brightest / w < h / 4,
+        "the light shows at row {} of {h}",
+        brightest / w
+    );
 }

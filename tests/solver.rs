@@ -227,6 +227,47 @@ fn open_scene() -> Scene {
     ))
 }
 
+/// Power (red channel) the samples reflect out of the scene: each sample's shot radiosity ×
+/// area × the share of `rays` cosine-distributed rays (a stratified grid) that hit nothing.
+fn reflected_escape(s: &meshlight::Solution, vis: &dyn meshlight::Visibility, rays: usize) -> f64 {
+    let n = (rays as f64).sqrt() as usize;
+    let mut out = 0.0;
+    for k in 0..s.samples.len() {
+        let normal = s.samples.normal[k];
+        let a = if normal.x.abs() < 0.9 {
+            Vec3::X
+        } else {
+            Vec3::Y
+        };
+        let t = (a - normal * normal.dot(a)).normalize();
+        let b = normal.cross(t);
+        let origin = s.samples.position[k] + normal * 1e-4;
+        let batch: Vec<meshlight::visibility::Ray> = (0..n * n)
+            .map(|i| {
+                // Malley: a uniform point of the disc lifted onto the hemisphere.
+                let (u, v) = (
+                    ((i % n) as f32 + 0.5) / n as f32,
+                    ((i / n) as f32 + 0.5) / n as f32,
+                );
+                let (r, phi) = (u.sqrt(), std::f32::consts::TAU * v);
+                let dir = t * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u).sqrt();
+                meshlight::visibility::Ray {
+                    origin,
+                    dir,
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                }
+            })
+            .collect();
+        let mut hits = vec![None; batch.len()];
+        vis.intersect(&batch, &mut hits).unwrap();
+        let missed = hits.iter().filter(|h| h.is_none()).count() as f64 / batch.len() as f64;
+        let shot = s.radiosity[k].x - s.unshot[k].x;
+        out += shot * s.samples.area[k] * missed;
+    }
+    out
+}
+
 /// Solid angle of the rectangle [x0, x1] × [z0, z1] of the plane at distance h from a point
 /// straight above the origin (sum over corners of atan(x z / (h √(h² + x² + z²)))).
 fn rectangle_solid_angle(x0: f64, x1: f64, z0: f64, z1: f64, h: f64) -> f64 {
@@ -256,6 +297,20 @@ fn energy_balance_in_an_open_scene() {
         assert!(
             escaped > 0.5 * emitted,
             "most light leaves an open scene: {escaped} of {emitted}"
+        );
+
+        // Escape measured, not defined as the remainder: the direct light missing floor and
+        // wall is I × (4π − their solid angles); of what each sample reflects, the share that
+        // leaves is the share of cosine-distributed rays from it that hit nothing.
+        let omega_floor = rectangle_solid_angle(-1.5, 2.5, -1.0, 3.0, 1.5);
+        let omega_wall = rectangle_solid_angle(-1.5, 2.5, -1.5, 0.5, 1.0);
+        let direct_out = 10.0 * (4.0 * std::f64::consts::PI - omega_floor - omega_wall);
+        let vis = backend.build(&scene).unwrap();
+        let reflected_out = reflected_escape(&s, vis.as_ref(), 256);
+        let measured = direct_out + reflected_out;
+        assert!(
+            (escaped - measured).abs() < 1e-3 * emitted,
+            "{backend}: the ledger's escape {escaped:.4} vs measured {measured:.4} (direct {direct_out:.4} + reflected {reflected_out:.4}) of {emitted:.4}"
         );
 
         // Independently: the direct flux on the floor is I × its solid angle from the light.
@@ -299,13 +354,16 @@ fn point_light_over_a_large_plane_follows_the_inverse_square_law() {
         },
     );
     assert!(s.samples.len() > 1000);
+    // By hand: a light at height h = 2 over the plane y = 0 gives E = I·cosθ/r² with
+    // cosθ = h/r, so E = I·h/r³ with r² = (x − 1)² + h² + (z + 0.5)².
+    let intensity = DVec3::new(5.0, 10.0, 20.0);
     for k in 0..s.samples.len() {
-        let d = light - s.samples.position[k];
-        let expected =
-            f64::from(d.y / d.length() / d.length_squared()) * DVec3::new(5.0, 10.0, 20.0);
+        let p = s.samples.position[k];
+        let r = f64::from(((p.x - 1.0).powi(2) + 4.0 + (p.z + 0.5).powi(2)).sqrt());
+        let expected = intensity * 2.0 / (r * r * r);
         let got = s.direct[k].irradiance;
         assert!(
-            (got - expected).abs().max_element() <= 0.01 * expected.max_element(),
+            (got - expected).abs().max_element() <= 1e-4 * expected.max_element(),
             "sample {k}: {got} vs {expected}"
         );
     }
@@ -355,11 +413,10 @@ fn one_or_two_threads_give_bit_identical_radiosity() {
     );
 }
 
+// Without Embree there is nothing to compare: the test is left out rather than passed.
+#[cfg(feature = "embree")]
 #[test]
 fn embree_and_obvhs_give_the_same_radiosity() {
-    if backends().len() < 2 {
-        return;
-    }
     let scene = Scene::load(shipped("room")).unwrap();
     let options = Options {
         rounds: 0,

@@ -110,7 +110,7 @@ fn toml_that_does_not_parse() {
         toml: "obj = \"s.obj\"\n[camera\n",
         ..Files::default()
     });
-    assert_names(&e, "scene.toml:2:", "");
+    assert_names(&e, "scene.toml:2:", "unclosed table");
     let e = error(Files {
         toml: "obj = \"s.obj\"\n",
         ..Files::default()
@@ -545,7 +545,7 @@ fn truncated_files_are_errors_not_panics() {
             ..Files::default()
         }),
         "scene.toml:6:",
-        "",
+        "key with no value",
     );
     let toml = "obj = \"s.o";
     assert_names(
@@ -554,7 +554,7 @@ fn truncated_files_are_errors_not_panics() {
             ..Files::default()
         }),
         "scene.toml:1:",
-        "",
+        "invalid basic string",
     );
     let obj = &OBJ[..OBJ.find("v 1 1 0").unwrap() + 5];
     assert_names(
