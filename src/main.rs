@@ -159,9 +159,14 @@ enum Command {
         #[arg(long)]
         no_pathtrace: bool,
         /// The path tracer's curve doubles samples per pixel from 2 up to this many, or until a
-        /// render takes twice as long as the slowest run.
+        /// render takes longer than --pathtrace-seconds.
         #[arg(long, default_value_t = 4096)]
         max_spp: u32,
+        /// The path tracer's curve stops after a render longer than this (default: twice the
+        /// slowest run). Its seed differs from --seed, so it never repeats the samples of a
+        /// reference traced with --seed.
+        #[arg(long)]
+        pathtrace_seconds: Option<f64>,
     },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
     Samples {
@@ -291,6 +296,8 @@ fn run(args: Args) -> anyhow::Result<()> {
                         None => meshlight::solver::choose_epsilon(&scene, &options)?.0,
                     },
                     supersample: supersample.max(1),
+                    tolerance: options.tolerance,
+                    max_shots: options.max_shots.unwrap_or(u64::MAX),
                     seed: options.seed,
                     threads: options.threads,
                     ..Default::default()
@@ -379,6 +386,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             out,
             no_pathtrace,
             max_spp,
+            pathtrace_seconds,
         } => {
             let scene = load(&solve.scene)?;
             let reference = meshlight::Image::read_exr(&reference)?;
@@ -396,6 +404,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                     out,
                     pathtrace_curve: !no_pathtrace,
                     max_spp,
+                    pathtrace_seconds,
                 },
             )?;
         }

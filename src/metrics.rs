@@ -53,7 +53,7 @@ pub fn compare(image: &Image, reference: &Image) -> Result<ImageError> {
         mae_over_mean: abs / (3.0 * n) / scale,
         rmse_over_mean: (sq / (3.0 * n)).sqrt() / scale,
         p99_over_mean: p99 / scale,
-        bias: (mean.iter().sum::<f64>() / 3.0 - scale) / scale,
+        bias: (mean.iter().sum::<f64>() - reference_mean.iter().sum::<f64>()) / 3.0 / scale,
         mean,
         reference_mean,
     })
@@ -74,6 +74,19 @@ pub fn signed_error_map(image: &Image, reference: &Image) -> Result<Vec<f32>> {
 }
 
 fn same_size(image: &Image, reference: &Image) -> Result<()> {
+    for (name, i) in [("image", image), ("reference", reference)] {
+        if i.pixels.len() as u64 != u64::from(i.width) * u64::from(i.height) {
+            return Err(Error::Option {
+                option: "compare",
+                problem: format!(
+                    "the {name} holds {} pixels, not {}x{}",
+                    i.pixels.len(),
+                    i.width,
+                    i.height
+                ),
+            });
+        }
+    }
     if (image.width, image.height) != (reference.width, reference.height) {
         return Err(Error::Option {
             option: "compare",
@@ -131,6 +144,23 @@ mod tests {
     }
 
     #[test]
+    fn errors_of_both_signs_cancel_in_the_bias_only() {
+        // One pixel 0.5 too bright, one 0.5 too dark: bias 0, MAE (0.5 + 0.5)·3 / 6 / 2.
+        let b = image(&[[1.0, 1.0, 1.0], [3.0, 3.0, 3.0]]);
+        let a = image(&[[1.5, 1.5, 1.5], [2.5, 2.5, 2.5]]);
+        let e = compare(&a, &b).unwrap();
+        assert!(e.bias.abs() < 1e-12, "{}", e.bias);
+        assert!(
+            (e.mae_over_mean - 0.25).abs() < 1e-12,
+            "{}",
+            e.mae_over_mean
+        );
+        // Two black images: no error and no bias, not −100%.
+        let black = image(&[[0.0; 3]]);
+        assert_eq!(compare(&black, &black).unwrap().bias, 0.0);
+    }
+
+    #[test]
     fn sizes_must_match() {
         let e = compare(&image(&[[0.0; 3]]), &image(&[[0.0; 3], [0.0; 3]])).unwrap_err();
         assert!(
@@ -138,5 +168,9 @@ mod tests {
             "{e}"
         );
         assert!(signed_error_map(&image(&[[0.0; 3]]), &image(&[[0.0; 3], [0.0; 3]])).is_err());
+        let mut short = image(&[[0.0; 3], [0.0; 3]]);
+        short.pixels.pop();
+        let e = compare(&short, &image(&[[0.0; 3], [0.0; 3]])).unwrap_err();
+        assert!(e.to_string().contains("holds 1 pixels, not 2x1"), "{e}");
     }
 }

@@ -3,7 +3,8 @@
 
 mod common;
 
-use common::{backends, shipped};
+use common::{backends, camera, material, shipped, Builder};
+use glam::Vec3;
 use meshlight::reference::{patch_radiosity, path_trace, PatchImage, PatchOptions, PathOptions};
 use meshlight::solver::Control;
 use meshlight::{Backend, Scene};
@@ -77,8 +78,10 @@ fn halving_the_patches_shrinks_the_change_and_meets_the_path_tracer() {
             "{backend}: patches of 0.1 against the path tracer: MAE/mean {:.4}",
             e.mae_over_mean
         );
-        // The coarsest mesh is far off: the check above is not met by any answer.
-        assert!(mae(&images[0].image, &traced.image) > 0.04);
+        // The coarsest mesh is far off: the 5% check above is not met by any answer.
+        let coarsest = mae(&images[0].image, &traced.image);
+        eprintln!("{backend}: coarsest mesh vs path tracer MAE/mean {coarsest:.4}");
+        assert!(coarsest > 0.05, "coarsest mesh: MAE/mean {coarsest:.4}");
     }
 }
 
@@ -101,13 +104,57 @@ fn furnace_holds_within_the_disc_form_factors_error() {
 }
 
 #[test]
+fn a_small_emitter_over_a_plane_lights_it_by_its_own_area() {
+    // A 0.05 m square emitter (Ke 100, B = 100π) 1 m over a 2 × 2 m plane of Kd 0.5, with
+    // patches of 0.1: the emitter is one patch of area 0.0025, the plane's are 0.01. Straight
+    // below, E = B·A/(π h²) = 100 · 0.0025 = 0.25 and the radiance Kd/π · E; bilinear
+    // interpolation from centres 0.05 off the axis lowers E by 1/(1 + 0.005)² (1%). Using the
+    // receiver's area instead of the shooter's would make it 4 times too bright.
+    let mut b = Builder::default();
+    let plane = b.material(material("plane", 0.5, 0.0));
+    let light = b.material(material("light", 0.0, 100.0));
+    b.quad(
+        [
+            Vec3::new(-1., 0., -1.),
+            Vec3::new(-1., 0., 1.),
+            Vec3::new(1., 0., 1.),
+            Vec3::new(1., 0., -1.),
+        ],
+        plane,
+    );
+    let a = 0.025;
+    b.quad(
+        [
+            Vec3::new(-a, 1., -a),
+            Vec3::new(a, 1., -a),
+            Vec3::new(a, 1., a),
+            Vec3::new(-a, 1., a),
+        ],
+        light,
+    );
+    // An odd image size puts the middle pixel's centre on the axis to the origin.
+    let scene = b.scene(camera(Vec3::new(0.3, 0.9, 0.0), Vec3::ZERO, 33));
+    let expected = 0.5 / std::f64::consts::PI * 0.25 / (1.005 * 1.005);
+    for backend in backends() {
+        let solved = patches(&scene, backend, 0.1);
+        assert_eq!(solved.patches, 400 + 1);
+        let got = f64::from(solved.image.pixels[16 * 33 + 16].x);
+        assert!(
+            (got - expected).abs() < 0.02 * expected,
+            "{backend}: radiance below the light {got}, expected {expected}"
+        );
+    }
+}
+
+#[test]
 fn bad_patch_sizes_are_clear_errors() {
     let scene = small("cornell", 8);
     let vis = Backend::Bvh.build(&scene).unwrap();
     for (size, expected) in [
         (0.0, "must be a positive length, not 0"),
         (f32::NAN, "must be a positive length, not NaN"),
-        (0.001, "more than the 200000 allowed"),
+        (0.001, "more than the 3200000 allowed"),
+        (0.01, "more than the 200000 allowed"),
     ] {
         let options = PatchOptions {
             patch_size: size,

@@ -533,3 +533,56 @@ fn too_small_an_epsilon_is_refused_before_allocating() {
         "{e}"
     );
 }
+
+/// Mean green radiosity of the ceiling's samples outside the light panel of `room` whose
+/// distance to the panel's outline lies in `lo..hi` (metres).
+fn ceiling_ring(s: &meshlight::Solution, lo: f32, hi: f32) -> f64 {
+    let (mut sum, mut count) = (0.0, 0);
+    for k in 0..s.samples.len() {
+        let (p, n) = (s.samples.position[k], s.samples.normal[k]);
+        if (p.y - 5.5).abs() > 1e-3 || n.y > -0.5 {
+            continue;
+        }
+        // The panel: x 2.15..3.35, z 5.65..6.85, 1 cm under the ceiling.
+        let dx = ((p.x - 2.75).abs() - 0.6).max(0.0);
+        let dz = ((p.z - 6.25).abs() - 0.6).max(0.0);
+        let d = dx.hypot(dz);
+        if d >= lo && d < hi {
+            sum += s.radiosity[k].y;
+            count += 1;
+        }
+    }
+    assert!(
+        count >= 10,
+        "only {count} ceiling samples {lo}..{hi} m from the panel"
+    );
+    sum / f64::from(count)
+}
+
+#[test]
+fn the_ceiling_beside_a_light_panel_is_not_darkened_by_the_dark_under_it() {
+    // By hand: from a ceiling point d ≥ 5 cm beside the panel hanging 1 cm below, the panel
+    // hides only directions less than atan(1/5) = 11.3° above the ceiling's plane on the side
+    // facing it: at most ½·sin²(11.3°) = 1.9% of the cosine-weighted hemisphere. And these
+    // points are nearer the bright floor under the light than the ring further out. So their
+    // mean radiosity is at least 0.98 × the ring's at 25–60 cm. Interpolating new samples'
+    // indirect light from old samples under the panel made the band 6–13% darker.
+    let scene = Scene::load(shipped("room")).unwrap();
+    for backend in backends() {
+        for threshold in [0.05, 0.0] {
+            let s = solve(
+                &scene,
+                backend,
+                Options {
+                    cluster_threshold: threshold,
+                    ..Options::default()
+                },
+            );
+            let (near, far) = (ceiling_ring(&s, 0.05, 0.25), ceiling_ring(&s, 0.25, 0.6));
+            assert!(
+                near >= 0.98 * far,
+                "{backend:?}, threshold {threshold}: beside the panel {near:.4}, further out {far:.4}"
+            );
+        }
+    }
+}

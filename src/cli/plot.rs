@@ -124,13 +124,13 @@ pub fn false_colour_png(
     font()?;
     let legend = 170u32;
     let (w, h) = (width + legend, height.max(300));
-    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
         for y in 0..height {
             for x in 0..width {
-                let v = values[(y * width + x) as usize];
+                let v = values[y as usize * width as usize + x as usize];
                 let [r, g, b] = diverging((f64::from(v) / range) as f32);
                 root.draw_pixel((x as i32, y as i32), &RGBColor(r, g, b))
                     .map_err(plot_error)?;
@@ -255,7 +255,7 @@ pub fn error_time_png(path: &Path, title: &str, series: &[Series]) -> Result<()>
     let (t0, t1) = (t0 / 1.5, t1 * 1.5);
     let (e0, e1) = (e0 / 1.5, e1 * 1.5);
     let (w, h) = (900u32, 600u32);
-    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
@@ -280,7 +280,7 @@ pub fn error_time_png(path: &Path, title: &str, series: &[Series]) -> Result<()>
                 .points
                 .iter()
                 .copied()
-                .filter(|&(t, e)| t > 0.0 && e > 0.0)
+                .filter(|&(t, e)| t > 0.0 && e > 0.0 && t.is_finite() && e.is_finite())
                 .collect();
             if s.line {
                 chart

@@ -38,6 +38,10 @@ const KEYS: &[&str] = &[
     "spp",
 ];
 
+/// Added to the seed of the path tracer's curve, so it shares no random numbers with a
+/// reference traced with the sweep's own seed.
+const CURVE_SEED: u64 = 0x9E37_79B9;
+
 /// What a sweep runs.
 pub struct Sweep {
     /// The settings to vary and their values, in the order given.
@@ -60,6 +64,8 @@ pub struct Sweep {
     pub pathtrace_curve: bool,
     /// The curve's largest samples per pixel.
     pub max_spp: u32,
+    /// The curve stops after a render longer than this (default: twice the slowest run).
+    pub pathtrace_seconds: Option<f64>,
 }
 
 /// Parses `key=v1,v2,...`.
@@ -83,6 +89,26 @@ pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String>
         return Err(format!("'{s}' gives {key} no values"));
     }
     Ok((key, values))
+}
+
+/// Whether `method` uses the setting `key`: a sweep over a setting the method ignores would
+/// label identical runs as different.
+fn used_by(method: Method, key: &str) -> bool {
+    match method {
+        Method::Meshless => !matches!(key, "patch-size" | "spp"),
+        Method::Patches => matches!(
+            key,
+            "epsilon"
+                | "patch-size"
+                | "tolerance"
+                | "max-shots"
+                | "backend"
+                | "threads"
+                | "seed"
+                | "supersample"
+        ),
+        Method::Pathtrace => matches!(key, "spp" | "backend" | "threads" | "seed"),
+    }
 }
 
 /// One run's settings beyond the solver's options.
@@ -166,6 +192,14 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
         bail!("the reference's size does not make a camera: {problem}");
     }
     // Check every setting before the first run.
+    for (key, _) in &sweep.vary {
+        if !used_by(sweep.method, key) {
+            bail!(
+                "--vary {key}: the {} method does not use it",
+                method_name(sweep.method)
+            );
+        }
+    }
     let points = grid(&sweep.vary);
     let mut runs = Vec::with_capacity(points.len());
     for point in &points {
@@ -227,10 +261,13 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
     let mut curve = Vec::new();
     if sweep.pathtrace_curve && sweep.method != Method::Pathtrace {
         let slowest = rows.iter().map(|r| r.total).fold(0.0, f64::max);
-        let budget = (2.0 * slowest).max(1.0);
-        let options = super::options_from(sweep.epsilon, &sweep.knobs)?;
+        let budget = sweep.pathtrace_seconds.unwrap_or((2.0 * slowest).max(1.0));
+        let mut options = super::options_from(sweep.epsilon, &sweep.knobs)?;
+        // A reference is usually path traced with the same seed: its samples would then
+        // include the curve's own, and the curve would meet it too soon. Another stream.
+        options.seed = options.seed.wrapping_add(CURVE_SEED);
         let vis = built(&mut backends, &scene, options.backend)?;
-        let mut spp = 2;
+        let mut spp = 2u32;
         while spp <= sweep.max_spp.max(2) {
             let extra = Extra {
                 supersample: 1,
@@ -246,10 +283,10 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             );
             let total = row.total;
             curve.push(row);
-            if total > budget {
-                break;
+            match spp.checked_mul(2) {
+                Some(next) if total <= budget => spp = next,
+                _ => break,
             }
-            spp *= 2;
         }
     }
     let csv = sweep.out.with_extension("csv");
@@ -355,6 +392,8 @@ fn measure(
                     None => meshlight::solver::choose_epsilon(scene, options)?.0,
                 },
                 supersample: extra.supersample,
+                tolerance: options.tolerance,
+                max_shots: options.max_shots.unwrap_or(u64::MAX),
                 seed: options.seed,
                 threads: options.threads,
                 ..Default::default()

@@ -177,6 +177,7 @@ pub fn path_trace(
             ),
         });
     }
+    scene.camera.check()?;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let pixels = w * h;
     let lights = Lights::new(scene);

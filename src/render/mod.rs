@@ -12,7 +12,7 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::parallel::for_chunks;
-use crate::sampling::{is_back, side_of, surface_of, Side};
+use crate::sampling::{cover, is_back, side_of, surface_of, Side};
 use crate::scene::Scene;
 use crate::solver::Solution;
 use crate::visibility::{Hit, Ray, Segment, Visibility};
@@ -58,6 +58,7 @@ pub fn render(
     options: &RenderOptions,
 ) -> Result<(Image, RenderStats)> {
     let camera = &scene.camera;
+    camera.check()?;
     let (w, h) = (camera.width as usize, camera.height as usize);
     let shader = Shader::new(scene, solution, vis);
     let mut stats = RenderStats::default();
@@ -173,6 +174,8 @@ struct Pending {
     /// Radiance when no sample is involved (misses, emitters without samples, black sides).
     fixed: Option<Vec3>,
     point: Vec3,
+    /// Whether something hovers over the hit.
+    covered: bool,
 }
 
 impl<'a> Shader<'a> {
@@ -191,22 +194,53 @@ impl<'a> Shader<'a> {
         }
     }
 
+    /// Whether sample k is covered (`sampling::cover`); a solution without the flags has none.
+    fn sample_covered(&self, k: usize) -> bool {
+        self.solution.covered.get(k).copied().unwrap_or(false)
+    }
+
     /// Shades a batch of rays: (radiance, side seen or u32::MAX). Returns visibility queries.
     fn shade(&self, rays: &[Ray], out: &mut [(Vec3, u32)]) -> Result<u64> {
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(rays, &mut hits)?;
+        // Whether each hit is covered, asked in one batch.
+        let covers: Vec<Segment> = rays
+            .iter()
+            .zip(&hits)
+            .filter_map(|(ray, hit)| {
+                let Hit { t, triangle } = (*hit)?;
+                let tri = &self.scene.triangles[triangle as usize];
+                let back = ray.dir.dot(tri.normal) > 0.0;
+                let normal = if back { -tri.normal } else { tri.normal };
+                let point = ray.origin + t * ray.dir;
+                Some(cover::segment(
+                    point,
+                    normal,
+                    self.lift,
+                    self.solution.epsilon,
+                ))
+            })
+            .collect();
+        let mut answers = vec![false; covers.len()];
+        self.vis.occluded(&covers, &mut answers)?;
+        let mut answer = answers.into_iter();
+        let covered: Vec<bool> = hits
+            .iter()
+            .map(|h| h.is_some() && answer.next().unwrap_or(false))
+            .collect();
         let s = &self.solution.samples;
         let mut pending = Vec::with_capacity(rays.len());
         let mut candidates: Vec<(u32, f32)> = Vec::new();
         let mut segments = Vec::new();
         let mut near = Vec::new();
-        for (ray, hit) in rays.iter().zip(&hits) {
+        for ((ray, hit), &hit_covered) in rays.iter().zip(&hits).zip(&covered) {
             let Some(Hit { t, triangle }) = *hit else {
                 pending.push(Pending {
                     side: u32::MAX,
                     candidates: 0..0,
                     fixed: Some(Vec3::ZERO),
                     point: Vec3::ZERO,
+                    covered: false,
                 });
                 continue;
             };
@@ -223,6 +257,7 @@ impl<'a> Shader<'a> {
                     candidates: 0..0,
                     fixed: Some(fixed),
                     point,
+                    covered: hit_covered,
                 });
                 continue;
             }
@@ -252,12 +287,13 @@ impl<'a> Shader<'a> {
                 candidates: start..candidates.len(),
                 fixed: None,
                 point,
+                covered: hit_covered,
             });
         }
         let tested: Vec<Segment> = segments.iter().flatten().copied().collect();
         let mut answers = vec![false; tested.len()];
         self.vis.occluded(&tested, &mut answers)?;
-        let mut queries = tested.len() as u64;
+        let mut queries = (tested.len() + covers.len()) as u64;
         let mut answer = answers.into_iter();
         let blocked: Vec<bool> = segments
             .iter()
@@ -267,12 +303,20 @@ impl<'a> Shader<'a> {
             let radiance = match p.fixed {
                 Some(l) => l,
                 None => {
+                    // Samples covered as the hit is; any visible one if there is none such.
                     let (mut wsum, mut sum) = (0.0f64, glam::DVec3::ZERO);
-                    for c in p.candidates.clone() {
-                        if !blocked[c] {
+                    for alike in [true, false] {
+                        for c in p.candidates.clone() {
                             let (k, w) = candidates[c];
-                            wsum += f64::from(w);
-                            sum += f64::from(w) * self.solution.radiosity[k as usize];
+                            if !blocked[c]
+                                && (!alike || self.sample_covered(k as usize) == p.covered)
+                            {
+                                wsum += f64::from(w);
+                                sum += f64::from(w) * self.solution.radiosity[k as usize];
+                            }
+                        }
+                        if wsum > 0.0 {
+                            break;
                         }
                     }
                     if wsum > 0.0 {

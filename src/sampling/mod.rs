@@ -3,6 +3,7 @@
 //! addition (eqs. 7-8).
 
 pub mod adaptive;
+pub(crate) mod cover;
 pub mod obstruction;
 pub mod poisson;
 pub mod surface_map;

@@ -25,6 +25,18 @@ pub struct Camera {
 pub(crate) const MAX_IMAGE_SIDE: u32 = 32768;
 
 impl Camera {
+    /// An error if this camera cannot make an image: for renderers, since a host may change a
+    /// loaded scene's camera.
+    pub(crate) fn check(&self) -> crate::error::Result<()> {
+        match self.problem() {
+            Some(problem) => Err(crate::error::Error::Option {
+                option: "camera",
+                problem,
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// Why this camera cannot make an image, if it cannot.
     pub fn problem(&self) -> Option<String> {
         let finite = self.position.is_finite() && self.look_at.is_finite() && self.up.is_finite();

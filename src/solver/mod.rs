@@ -64,6 +64,8 @@ pub struct Solution {
     pub obstruction: Obstruction,
     /// Per sample: whether all its probe rays hit the scene (a closed hemisphere).
     pub closed: Vec<bool>,
+    /// Per sample: whether something hovers over it (see `sampling::cover`).
+    pub covered: Vec<bool>,
     /// Per sample: the factor its received form factors are scaled by (row normalisation).
     pub row_scale: Vec<f32>,
 }
@@ -229,6 +231,7 @@ fn solve_with(
         index: SideIndex::default(),
         obstruction,
         closed: Vec::new(),
+        covered: Vec::new(),
         row_scale: Vec::new(),
     };
     let mut added = AddedSamples {

@@ -16,7 +16,9 @@ use crate::error::Result;
 use crate::light::DirectLight;
 use crate::parallel::for_chunks;
 use crate::sampling::adaptive::{self, RefineSettings};
-use crate::sampling::{poisson, reflecting_sides, surface_of, Samples, SideIndex, SurfaceMap};
+use crate::sampling::{
+    cover, poisson, reflecting_sides, surface_of, Samples, SideIndex, SurfaceMap,
+};
 use crate::scene::Scene;
 use crate::visibility::Visibility;
 
@@ -168,6 +170,8 @@ impl Solve<'_> {
                 options.tolerance,
             ),
         )?;
+        let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
+        solution.covered.extend(covered);
         seconds.direct = t.elapsed().as_secs_f64();
         warm::start(
             scene,
@@ -215,13 +219,17 @@ impl Solve<'_> {
         for k in first_new..n {
             // The flat solver sums rows in its first round only: later samples take the scale
             // of their nearest old sample. The hierarchy sums every round's rows.
+            // A neighbour covered as it is: a row scale corrects the discretisation, which
+            // differs under a cover and beside it.
             let s = &solution.samples;
             let scale = if round == 0 || hierarchical {
                 1.0
             } else {
-                solution
-                    .index
-                    .nearest_where(s, s.side[k], s.uv[k], |j| (j as usize) < first_new)
+                let covered = &solution.covered;
+                let old = |j: u32| (j as usize) < first_new;
+                let alike = |j: u32| old(j) && covered[j as usize] == covered[k];
+                (solution.index.nearest_where(s, s.side[k], s.uv[k], alike))
+                    .or_else(|| solution.index.nearest_where(s, s.side[k], s.uv[k], old))
                     .map_or(1.0, |j| solution.row_scale[j as usize])
             };
             solution.row_scale.push(scale);

@@ -69,6 +69,11 @@ pub(crate) fn start(
                     samples.position[k],
                     &mut near,
                 )?;
+                // Neighbours covered as this sample is, if there are any (`sampling::cover`).
+                let covered = &shared.covered;
+                if near.iter().any(|&(j, _)| covered[j as usize] == covered[k]) {
+                    near.retain(|&(j, _)| covered[j as usize] == covered[k]);
+                }
                 for &(j, d2) in &near {
                     let j = j as usize;
                     let w = f64::from((-alpha * d2.sqrt() / r).exp());

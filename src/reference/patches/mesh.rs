@@ -70,6 +70,34 @@ pub(crate) fn estimate(scene: &Scene, size: f32) -> f64 {
         .sum()
 }
 
+/// Cells the grids of all surfaces would hold (each surface's bounding box in its plane, in
+/// cells of side `size`), in floating point so no count overflows.
+pub(crate) fn grid_cells(scene: &Scene, size: f32) -> f64 {
+    let h = f64::from(size);
+    scene
+        .surfaces
+        .iter()
+        .map(|surface| {
+            let (u, v) = frame(surface.normal);
+            let triangles =
+                &scene.triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+            let (mut lo, mut hi) = (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN));
+            for t in triangles {
+                for &p in &t.vertices {
+                    let q = DVec2::new(p.dot(u).into(), p.dot(v).into());
+                    lo = lo.min(q);
+                    hi = hi.max(q);
+                }
+            }
+            if triangles.is_empty() {
+                0.0
+            } else {
+                ((hi.x - lo.x) / h).ceil().max(1.0) * ((hi.y - lo.y) / h).ceil().max(1.0)
+            }
+        })
+        .sum()
+}
+
 /// Meshes every surface that reflects or emits into patches of side `size`.
 pub(crate) fn mesh(scene: &Scene, size: f32) -> Mesh {
     let h = f64::from(size);

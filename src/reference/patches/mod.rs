@@ -15,6 +15,9 @@ use crate::solver::Control;
 use crate::visibility::workload::LIFT;
 use crate::visibility::Visibility;
 
+/// Most rays per side of a pixel when rendering patches.
+pub const MAX_SUPERSAMPLE: u32 = 16;
+
 /// Patch radiosity settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchOptions {
@@ -101,6 +104,29 @@ pub fn patch_radiosity(
             problem: format!("must lie in (0, 1), not {}", options.tolerance),
         });
     }
+    scene.camera.check()?;
+    if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
+        return Err(Error::Option {
+            option: "supersample",
+            problem: format!(
+                "{} rays per side of a pixel: it must lie in 1..={MAX_SUPERSAMPLE}",
+                options.supersample
+            ),
+        });
+    }
+    // The grids span each surface's bounding box in its plane: a thin diagonal strip or a
+    // ring holds far more cells than its area says. Bound them before allocating.
+    let cells = mesh::grid_cells(scene, size);
+    let cell_limit = 16.0 * options.max_patches as f64;
+    if cells > cell_limit {
+        return Err(Error::Option {
+            option: "patch-size",
+            problem: format!(
+                "{size} lays grids of {cells:.0} cells over the surfaces' bounding boxes, more \
+                 than the {cell_limit:.0} allowed (16 × the patch limit): choose a larger size"
+            ),
+        });
+    }
     let estimate = mesh::estimate(scene, size);
     if estimate > options.max_patches as f64 {
         return Err(Error::Option {
@@ -115,6 +141,17 @@ pub fn patch_radiosity(
     }
     let t = std::time::Instant::now();
     let mesh = mesh::mesh(scene, size);
+    if mesh.patches.len() > options.max_patches {
+        return Err(Error::Option {
+            option: "patch-size",
+            problem: format!(
+                "{size} cuts the surfaces into {} patches (slivers of cells count too), more \
+                 than the {} allowed: choose a larger size",
+                mesh.patches.len(),
+                options.max_patches
+            ),
+        });
+    }
     let meshing = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
     let lift = LIFT * scene.bounds.diagonal();

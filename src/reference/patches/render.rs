@@ -72,7 +72,9 @@ pub(crate) fn render(
     let (w, h) = (camera.width as usize, camera.height as usize);
     let n = supersample.max(1) as usize;
     let mut pixels = vec![Vec3::ZERO; w * h];
-    for_chunks(&mut pixels, w * 4, threads, |first, out| {
+    // About 64k rays per chunk, whatever the supersampling.
+    let chunk = (65_536 / (n * n)).max(1);
+    for_chunks(&mut pixels, chunk, threads, |first, out| {
         let mut rays = Vec::with_capacity(out.len() * n * n);
         for p in first..first + out.len() {
             let mut rng =
