@@ -30,7 +30,7 @@ fn main() -> meshlight::Result<()> {
     };
     let (_, reference) = run(&room, &one_round)?;
     for s in [1e-3f32, 1e3] {
-        let (_, image) = run(&room.scaled(s), &one_round)?;
+        let (_, image) = run(&room.scaled(s)?, &one_round)?;
         println!(
             "scene scaled by {s}: MAE/mean {:.2e}",
             relative(&image, &reference, 1.0)
@@ -38,7 +38,7 @@ fn main() -> meshlight::Result<()> {
     }
     let (_, default) = run(&room, &Options::default())?;
     for f in [1e-6f32, 1e6] {
-        let (_, image) = run(&room.with_lights_scaled(f), &Options::default())?;
+        let (_, image) = run(&room.with_lights_scaled(f)?, &Options::default())?;
         println!(
             "lights × {f}: relative difference {:.2e}",
             relative(&image, &default, f64::from(f))

@@ -386,10 +386,11 @@ fn area_centroid(poly: &[Vec2]) -> Option<(f64, Vec2)> {
     Some((0.5 * twice.abs(), centroid))
 }
 
-/// Area carried by each side's samples minus the side's area, relative (0 when conserved).
-pub fn conservation_error(samples: &Samples, maps: &[SurfaceMap]) -> f64 {
-    let per_side = samples.area_per_side(2 * maps.len());
-    per_side
+/// Area carried by each side's samples minus the side's area, relative (0 when conserved);
+/// an error if the samples lie on sides `maps` does not have.
+pub fn conservation_error(samples: &Samples, maps: &[SurfaceMap]) -> crate::Result<f64> {
+    let per_side = samples.area_per_side(2 * maps.len())?;
+    Ok(per_side
         .iter()
         .enumerate()
         .filter(|(_, &a)| a > 0.0)
@@ -397,7 +398,7 @@ pub fn conservation_error(samples: &Samples, maps: &[SurfaceMap]) -> f64 {
             let expected = maps[surface_of(side as u32) as usize].area();
             (a - expected).abs() / expected
         })
-        .fold(0.0, f64::max)
+        .fold(0.0, f64::max))
 }
 
 #[cfg(test)]

@@ -9,20 +9,21 @@ use std::path::{Path, PathBuf};
 #[non_exhaustive]
 pub enum Error {
     /// A file could not be opened or read.
-    #[error("{}: cannot read: {source}", path.display())]
+    #[error("{}: cannot read: {cause}", path.display())]
     Read {
         /// The file.
         path: PathBuf,
-        /// What the operating system said.
-        source: std::io::Error,
+        /// What the operating system said (in the message already, so not a `source()`:
+        /// printing the chain would say it twice).
+        cause: std::io::Error,
     },
     /// A file could not be written.
-    #[error("{}: cannot write: {source}", path.display())]
+    #[error("{}: cannot write: {cause}", path.display())]
     Write {
         /// The file.
         path: PathBuf,
-        /// What the operating system said.
-        source: std::io::Error,
+        /// What the operating system said (in the message already).
+        cause: std::io::Error,
     },
     /// A scene file (TOML, OBJ or MTL) is malformed or describes something invalid.
     #[error("{}: {problem}", Location { path, line: *line })]
@@ -48,6 +49,15 @@ pub enum Error {
         /// What happened.
         problem: String,
     },
+    /// A host passed the library something it cannot use: a solution of another scene, an
+    /// index out of range, an image whose pixels do not match its size.
+    #[error("invalid argument {argument}: {problem}")]
+    Argument {
+        /// The argument's name.
+        argument: &'static str,
+        /// What is wrong with it.
+        problem: String,
+    },
     /// An option value is out of range or inconsistent.
     #[error("invalid option {option}: {problem}")]
     Option {
@@ -62,6 +72,14 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// A bad argument from a host.
+    pub(crate) fn argument(argument: &'static str, problem: impl Into<String>) -> Self {
+        Error::Argument {
+            argument,
+            problem: problem.into(),
+        }
+    }
+
     /// A problem in a scene file, with or without a line.
     pub(crate) fn scene(path: &Path, line: Option<usize>, problem: impl Into<String>) -> Self {
         Error::Scene {

@@ -15,7 +15,17 @@ use meshlight::{Backend, Scene};
 struct Args {
     #[command(subcommand)]
     command: Command,
+    /// Refuse a reflectance (Kd) channel of exactly 1 instead of lowering it.
+    #[arg(long, global = true)]
+    strict: bool,
+    /// What a reflectance channel of exactly 1 is lowered to (default: the scene file's
+    /// [solver] max_reflectance, else 0.9).
+    #[arg(long, global = true)]
+    max_reflectance: Option<f32>,
 }
+
+/// How scenes are read, from the command line (set once, before any scene is loaded).
+static LOADING: std::sync::OnceLock<meshlight::scene::LoadOptions> = std::sync::OnceLock::new();
 
 /// Solver settings shared by `render` and `samples`.
 #[derive(clap::Args)]
@@ -124,6 +134,10 @@ enum Command {
         /// mean (default: the 99th percentile of |error|, rounded up to 1, 2 or 5).
         #[arg(long)]
         diff_range: Option<f64>,
+        /// Compare averages over blocks of N × N pixels: a noisy reference's noise falls by
+        /// about N, errors spanning several pixels stay.
+        #[arg(long, default_value_t = 1)]
+        block: u32,
     },
     /// Run a grid of settings against a reference image: a CSV of time and error per run, and
     /// a plot of error against time with the Pareto front and the path tracer's curve.
@@ -158,6 +172,9 @@ enum Command {
         /// Leave out the path tracer's curve.
         #[arg(long)]
         no_pathtrace: bool,
+        /// Measure errors on averages over blocks of N × N pixels (see `compare --block`).
+        #[arg(long, default_value_t = 1)]
+        block: u32,
         /// The path tracer's curve doubles samples per pixel from 2 up to this many, or until a
         /// render takes longer than --pathtrace-seconds.
         #[arg(long, default_value_t = 4096)]
@@ -237,7 +254,12 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    match run(Args::parse()) {
+    let args = Args::parse();
+    let _ = LOADING.set(meshlight::scene::LoadOptions {
+        max_reflectance: args.max_reflectance,
+        strict: args.strict,
+    });
+    match run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("meshlight: error: {e:#}");
@@ -349,10 +371,11 @@ fn run(args: Args) -> anyhow::Result<()> {
             reference,
             diff,
             diff_range,
+            block,
         } => {
             let a = meshlight::Image::read_exr(&image)?;
             let b = meshlight::Image::read_exr(&reference)?;
-            let e = meshlight::metrics::compare(&a, &b)?;
+            let e = meshlight::metrics::compare_blocks(&a, &b, block)?;
             println!("MAE/mean {:.5}", e.mae_over_mean);
             println!("bias {:+.5} (mean difference / reference mean)", e.bias);
             println!("RMSE/mean {:.5}", e.rmse_over_mean);
@@ -385,6 +408,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             spp,
             out,
             no_pathtrace,
+            block,
             max_spp,
             pathtrace_seconds,
         } => {
@@ -403,6 +427,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                     spp,
                     out,
                     pathtrace_curve: !no_pathtrace,
+                    block,
                     max_spp,
                     pathtrace_seconds,
                 },
@@ -479,7 +504,8 @@ fn run(args: Args) -> anyhow::Result<()> {
 
 /// Loads a scene and prints its warnings to stderr.
 fn load(path: &std::path::Path) -> anyhow::Result<Scene> {
-    let scene = Scene::load(path)?;
+    let options = LOADING.get().copied().unwrap_or_default();
+    let scene = Scene::load_with(&meshlight::scene::Disk, path, &options)?;
     for warning in &scene.warnings {
         eprintln!("meshlight: warning: {warning}");
     }

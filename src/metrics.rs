@@ -59,6 +59,52 @@ pub fn compare(image: &Image, reference: &Image) -> Result<ImageError> {
     })
 }
 
+/// The image averaged over blocks of `block` × `block` pixels (rows and columns that do not
+/// fill a block are left out). Comparing averages of blocks takes a noisy reference's noise
+/// down by about `block` while errors that span several pixels stay.
+pub fn block_average(image: &Image, block: u32) -> Result<Image> {
+    image.check()?;
+    let (w, h) = (image.width / block.max(1), image.height / block.max(1));
+    if block == 0 || w == 0 || h == 0 {
+        return Err(Error::Option {
+            option: "block",
+            problem: format!(
+                "{block} does not fit a {} × {} image",
+                image.width, image.height
+            ),
+        });
+    }
+    let b = block as usize;
+    let mut pixels = vec![glam::Vec3::ZERO; (w * h) as usize];
+    for y in 0..h as usize * b {
+        for x in 0..w as usize * b {
+            pixels[(y / b) * w as usize + x / b] += image.pixels[y * image.width as usize + x];
+        }
+    }
+    let n = (b * b) as f32;
+    for p in &mut pixels {
+        *p /= n;
+    }
+    Ok(Image {
+        width: w,
+        height: h,
+        pixels,
+    })
+}
+
+/// [`compare`] on averages over blocks of `block` × `block` pixels ([`block_average`]);
+/// `block` 1 is [`compare`] itself.
+pub fn compare_blocks(image: &Image, reference: &Image, block: u32) -> Result<ImageError> {
+    same_size(image, reference)?;
+    if block == 1 {
+        return compare(image, reference);
+    }
+    compare(
+        &block_average(image, block)?,
+        &block_average(reference, block)?,
+    )
+}
+
 /// Per pixel, the signed error (a − b, averaged over channels) divided by the reference's
 /// mean: the map a false-colour error image shows. Errors if the sizes differ.
 pub fn signed_error_map(image: &Image, reference: &Image) -> Result<Vec<f32>> {
@@ -102,6 +148,34 @@ fn same_size(image: &Image, reference: &Image) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn block_averages_by_hand() {
+        // 5 × 3 image, blocks of 2: the last column and row are left out; 2 × 1 blocks.
+        let pixels = (0..15).map(|i| Vec3::splat(i as f32)).collect();
+        let image = Image {
+            width: 5,
+            height: 3,
+            pixels,
+        };
+        let b = block_average(&image, 2).unwrap();
+        assert_eq!((b.width, b.height), (2, 1));
+        // (0 + 1 + 5 + 6) / 4 = 3, (2 + 3 + 7 + 8) / 4 = 5.
+        assert_eq!(b.pixels, vec![Vec3::splat(3.0), Vec3::splat(5.0)]);
+        assert!(block_average(&image, 4).is_err());
+        assert!(block_average(&image, 0).is_err());
+        // Errors of both signs within a block cancel: 0 at blocks of 2, not at 1.
+        let a = Image {
+            width: 2,
+            height: 2,
+            pixels: vec![Vec3::ONE; 4],
+        };
+        let mut r = a.clone();
+        r.pixels[0] = Vec3::splat(2.0);
+        r.pixels[1] = Vec3::ZERO;
+        assert_eq!(compare_blocks(&a, &r, 2).unwrap().mae_over_mean, 0.0);
+        assert_eq!(compare_blocks(&a, &r, 1).unwrap().mae_over_mean, 0.5);
+    }
     use glam::Vec3;
 
     fn image(pixels: &[[f32; 3]]) -> Image {

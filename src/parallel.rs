@@ -5,7 +5,27 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use crate::error::Result;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use crate::error::{Error, Result};
+
+/// Runs `f`, turning a panic (in a host's own `Visibility`, say) into [`Error::Worker`] naming
+/// `what` and the panic's message: a host must never be taken down by the library.
+pub(crate) fn guarded<R>(what: &str, f: impl FnOnce() -> Result<R>) -> Result<R> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(result) => result,
+        Err(panic) => {
+            let message = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "a panic without a message".into());
+            Err(Error::Worker {
+                problem: format!("{what} panicked: {message}"),
+            })
+        }
+    }
+}
 
 /// Fills `out` chunk by chunk: `f(first_index, chunk)`, on up to `threads` threads.
 pub(crate) fn for_chunks<T: Send>(
@@ -18,7 +38,7 @@ pub(crate) fn for_chunks<T: Send>(
     let threads = threads.max(1).min(out.len().div_ceil(chunk).max(1));
     if threads == 1 {
         for (i, c) in out.chunks_mut(chunk).enumerate() {
-            f(i * chunk, c)?;
+            guarded("a worker", || f(i * chunk, c))?;
         }
         return Ok(());
     }
@@ -34,7 +54,7 @@ pub(crate) fn for_chunks<T: Send>(
                 let Some(c) = slot.lock().unwrap_or_else(|e| e.into_inner()).take() else {
                     continue;
                 };
-                if let Err(e) = f(i * chunk, c) {
+                if let Err(e) = guarded("a worker", || f(i * chunk, c)) {
                     first_error
                         .lock()
                         .unwrap_or_else(|e| e.into_inner())

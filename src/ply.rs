@@ -11,7 +11,7 @@ use crate::solver::Solution;
 pub fn write_samples(solution: &Solution, path: &Path, exposure: f32) -> Result<()> {
     let fail = |source| Error::Write {
         path: path.into(),
-        source,
+        cause: source,
     };
     let file = std::fs::File::create(path).map_err(fail)?;
     let mut out = std::io::BufWriter::new(file);

@@ -45,6 +45,8 @@ fn errors_name_the_file_and_exit_non_zero() {
         "{stderr}"
     );
     assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    // The cause is said once, not once per level of the error chain.
+    assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
 }
 
 #[test]

@@ -136,7 +136,7 @@ fn scaling_the_scene_leaves_the_image_alone() {
     };
     let (_, reference) = solve(&room, &options);
     for s in [1e-3f32, 1e3] {
-        let (_, image) = solve(&room.scaled(s), &options);
+        let (_, image) = solve(&room.scaled(s).unwrap(), &options);
         let d = relative_difference(&image, &reference, 1.0);
         assert!(d < 1e-3, "scale {s}: MAE/mean {d}");
     }
@@ -148,7 +148,7 @@ fn scaling_the_lights_scales_the_image() {
     let options = Options::default();
     let (_, reference) = solve(&room, &options);
     for f in [1e-6f32, 1e6] {
-        let (_, image) = solve(&room.with_lights_scaled(f), &options);
+        let (_, image) = solve(&room.with_lights_scaled(f).unwrap(), &options);
         let d = relative_difference(&image, &reference, f64::from(f));
         assert!(d < 1e-5, "lights × {f}: relative difference {d}");
     }
@@ -311,7 +311,8 @@ fn a_lone_triangle_and_a_light_with_nothing_to_light() {
 fn a_scene_without_light_renders_black() {
     let room = Scene::load(shipped("room"))
         .unwrap()
-        .with_lights_scaled(0.0);
+        .with_lights_scaled(0.0)
+        .unwrap();
     let (s, image) = solve(&room, &Options::default());
     assert_eq!(s.stop(), StopReason::NoLight);
     assert!(image.pixels.iter().all(|p| *p == Vec3::ZERO));

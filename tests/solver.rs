@@ -180,7 +180,7 @@ fn areas_are_conserved_per_surface_also_after_adaptive_rounds() {
         s.rounds.len() >= 2 && s.rounds[1].added > 0,
         "adaptive rounds added samples"
     );
-    let per_side = s.samples.area_per_side(2 * scene.surfaces.len());
+    let per_side = s.samples.area_per_side(2 * scene.surfaces.len()).unwrap();
     for (side, &area) in per_side.iter().enumerate() {
         if area > 0.0 {
             let expected = scene.surfaces[side / 2].area;

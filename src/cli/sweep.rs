@@ -62,6 +62,8 @@ pub struct Sweep {
     pub out: PathBuf,
     /// Add the path tracer's curve (doubling spp) to the CSV and the plot.
     pub pathtrace_curve: bool,
+    /// Errors on averages over blocks of this many pixels a side (1: per pixel).
+    pub block: u32,
     /// The curve's largest samples per pixel.
     pub max_spp: u32,
     /// The curve stops after a render longer than this (default: twice the slowest run).
@@ -117,6 +119,8 @@ struct Extra {
     supersample: u32,
     patch_size: Option<f32>,
     spp: u32,
+    /// Errors on averages over blocks of this many pixels a side.
+    block: u32,
 }
 
 fn value<T: FromStr>(key: &str, v: &str) -> Result<T> {
@@ -192,6 +196,9 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
         bail!("the reference's size does not make a camera: {problem}");
     }
     // Check every setting before the first run.
+    if sweep.block != 1 {
+        meshlight::metrics::block_average(reference, sweep.block)?;
+    }
     for (key, _) in &sweep.vary {
         if !used_by(sweep.method, key) {
             bail!(
@@ -214,6 +221,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             supersample: sweep.supersample.max(1),
             patch_size: sweep.patch_size,
             spp: sweep.spp,
+            block: sweep.block,
         };
         for (k, v) in point {
             apply(k, v, &mut options, &mut extra)?;
@@ -222,13 +230,18 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
     }
     let keys: Vec<&str> = sweep.vary.iter().map(|(k, _)| k.as_str()).collect();
     println!(
-        "sweep of {} on {} at {}x{}: {} run(s) of {}",
+        "sweep of {} on {} at {}x{}: {} run(s) of {}{}",
         keys.join(" × "),
         scene.path.display(),
         reference.width,
         reference.height,
         runs.len(),
-        method_name(sweep.method)
+        method_name(sweep.method),
+        if sweep.block > 1 {
+            format!("; errors over blocks of {0}x{0} pixels", sweep.block)
+        } else {
+            String::new()
+        }
     );
     let mut backends: HashMap<Backend, Box<dyn Visibility>> = HashMap::new();
     let mut rows = Vec::new();
@@ -273,6 +286,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
                 supersample: 1,
                 patch_size: None,
                 spp,
+                block: sweep.block,
             };
             let row = measure(&scene, vis, reference, Method::Pathtrace, &options, &extra)?;
             println!(
@@ -422,7 +436,7 @@ fn measure(
         }
     };
     row.total = started.elapsed().as_secs_f64();
-    row.error = meshlight::metrics::compare(&image, reference)?;
+    row.error = meshlight::metrics::compare_blocks(&image, reference, extra.block)?;
     Ok(row)
 }
 

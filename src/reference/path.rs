@@ -168,6 +168,18 @@ pub fn path_trace(
     options: &PathOptions,
     progress: &mut dyn FnMut(&PathProgress),
 ) -> Result<PathImage> {
+    crate::parallel::guarded("the path tracer", || {
+        path_trace_unguarded(scene, vis, options, progress)
+    })
+}
+
+/// [`path_trace`] without its guard against panics.
+fn path_trace_unguarded(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &PathOptions,
+    progress: &mut dyn FnMut(&PathProgress),
+) -> Result<PathImage> {
     if options.spp < 2 {
         return Err(Error::Option {
             option: "spp",

@@ -25,11 +25,29 @@ impl Image {
         sum / (3 * self.pixels.len().max(1)) as f64
     }
 
+    /// Whether the pixels fill width × height exactly (a host may have built it by hand).
+    pub fn check(&self) -> Result<()> {
+        let size = u64::from(self.width) * u64::from(self.height);
+        if size == 0 || size != self.pixels.len() as u64 {
+            return Err(Error::argument(
+                "image",
+                format!(
+                    "{} pixels for a {} × {} image",
+                    self.pixels.len(),
+                    self.width,
+                    self.height
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Writes linear OpenEXR.
     pub fn write_exr(&self, path: &Path) -> Result<()> {
+        self.check()?;
         let data: Vec<f32> = self.pixels.iter().flat_map(|p| p.to_array()).collect();
         let buffer = ::image::Rgb32FImage::from_raw(self.width, self.height, data)
-            .expect("width × height pixels");
+            .ok_or_else(|| Error::argument("image", "too large to write"))?;
         buffer
             .save_with_format(path, ::image::ImageFormat::OpenExr)
             .map_err(|e| write_error(path, e))
@@ -40,12 +58,12 @@ impl Image {
         let decoded = ::image::ImageReader::open(path)
             .map_err(|source| Error::Read {
                 path: path.into(),
-                source,
+                cause: source,
             })?
             .with_guessed_format()
             .map_err(|source| Error::Read {
                 path: path.into(),
-                source,
+                cause: source,
             })?
             .decode()
             .map_err(|e| Error::scene(path, None, format!("cannot decode the image: {e}")))?
@@ -77,6 +95,7 @@ impl Image {
 
     /// Writes an 8-bit sRGB PNG after multiplying by `exposure` and clipping.
     pub fn write_png(&self, path: &Path, exposure: f32) -> Result<()> {
+        self.check()?;
         let data: Vec<u8> = self
             .pixels
             .iter()
@@ -84,7 +103,7 @@ impl Image {
             .map(|v| (srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
             .collect();
         let buffer = ::image::RgbImage::from_raw(self.width, self.height, data)
-            .expect("width × height pixels");
+            .ok_or_else(|| Error::argument("image", "too large to write"))?;
         buffer
             .save_with_format(path, ::image::ImageFormat::Png)
             .map_err(|e| write_error(path, e))
@@ -104,11 +123,11 @@ fn write_error(path: &Path, e: ::image::ImageError) -> Error {
     match e {
         ::image::ImageError::IoError(source) => Error::Write {
             path: path.into(),
-            source,
+            cause: source,
         },
         other => Error::Write {
             path: path.into(),
-            source: std::io::Error::other(other.to_string()),
+            cause: std::io::Error::other(other.to_string()),
         },
     }
 }

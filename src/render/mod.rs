@@ -57,8 +57,21 @@ pub fn render(
     vis: &dyn Visibility,
     options: &RenderOptions,
 ) -> Result<(Image, RenderStats)> {
+    crate::parallel::guarded("rendering", || {
+        render_unguarded(scene, solution, vis, options)
+    })
+}
+
+/// [`render`] without its guard against panics.
+fn render_unguarded(
+    scene: &Scene,
+    solution: &Solution,
+    vis: &dyn Visibility,
+    options: &RenderOptions,
+) -> Result<(Image, RenderStats)> {
     let camera = &scene.camera;
     camera.check()?;
+    solution.check_fits(scene)?;
     let (w, h) = (camera.width as usize, camera.height as usize);
     let shader = Shader::new(scene, solution, vis);
     let mut stats = RenderStats::default();

@@ -107,13 +107,20 @@ impl Samples {
         self.round.push(round);
     }
 
-    /// Total area of the samples of each side (index: side id).
-    pub fn area_per_side(&self, sides: usize) -> Vec<f64> {
+    /// Total area of the samples of each of `sides` sides (index: side id); an error if a
+    /// sample lies on a side beyond them.
+    pub fn area_per_side(&self, sides: usize) -> crate::Result<Vec<f64>> {
         let mut total = vec![0.0; sides];
         for (&s, &a) in self.side.iter().zip(&self.area) {
-            total[s as usize] += a;
+            let Some(t) = total.get_mut(s as usize) else {
+                return Err(crate::Error::argument(
+                    "sides",
+                    format!("a sample lies on side {s}, beyond the {sides} sides asked for"),
+                ));
+            };
+            *t += a;
         }
-        total
+        Ok(total)
     }
 }
 
@@ -149,6 +156,20 @@ pub struct SideIndex {
     /// Cell k's samples are entries[starts[k]..starts[k+1]].
     starts: Vec<u32>,
     entries: Vec<u32>,
+}
+
+impl SideIndex {
+    /// Whether the index holds no more sides than `sides` and only samples below `samples`
+    /// (so queries on a solution a host has edited cannot reach past its arrays).
+    pub fn fits(&self, sides: usize, samples: usize) -> bool {
+        self.grids.len() <= sides
+            && self.entries.iter().all(|&k| (k as usize) < samples)
+            && self.starts.windows(2).all(|w| w[0] <= w[1])
+            && self
+                .starts
+                .last()
+                .is_none_or(|&e| e as usize <= self.entries.len())
+    }
 }
 
 #[derive(Clone, Copy, Debug)]

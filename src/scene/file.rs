@@ -46,6 +46,7 @@ struct PointLightToml {
 #[serde(deny_unknown_fields)]
 struct SolverToml {
     epsilon: Option<f32>,
+    max_reflectance: Option<f32>,
 }
 
 /// What the scene file says, checked, with the OBJ path resolved.
@@ -55,6 +56,10 @@ pub(super) struct SceneFile {
     pub camera: Camera,
     pub point_lights: Vec<PointLight>,
     pub solver: SolverDefaults,
+    /// The `obj =` line.
+    pub obj_line: usize,
+    /// Comment lines of the scene file that name the OBJ file (how to make it, say).
+    pub obj_notes: Vec<String>,
 }
 
 /// 1-based line of a byte offset.
@@ -70,7 +75,7 @@ pub(crate) fn line_of(text: &str, offset: usize) -> usize {
 pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> {
     let bytes = files.read(path).map_err(|source| Error::Read {
         path: path.into(),
-        source,
+        cause: source,
     })?;
     let text = std::str::from_utf8(&bytes).map_err(|e| {
         let line = line_of(
@@ -127,6 +132,10 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
             return Err(at(span, format!("[solver] {problem}")));
         }
         solver.epsilon = s.epsilon;
+        if let Some(problem) = s.max_reflectance.and_then(validate::max_reflectance) {
+            return Err(at(span, format!("[solver] {problem}")));
+        }
+        solver.max_reflectance = s.max_reflectance;
     }
 
     let obj_span = parsed.obj.span();
@@ -138,12 +147,24 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         ));
     }
     let dir = path.parent().unwrap_or(Path::new(""));
+    let name = Path::new(&obj).file_name().map(|n| n.to_string_lossy());
+    let obj_notes = name
+        .map(|name| {
+            let comments = text.lines().filter_map(|l| l.trim().strip_prefix('#'));
+            comments
+                .filter(|c| c.contains(name.as_ref()))
+                .map(|c| c.trim().to_string())
+                .collect()
+        })
+        .unwrap_or_default();
     Ok(SceneFile {
-        obj: dir.join(obj),
+        obj: dir.join(&obj),
         two_sided: parsed.two_sided,
         camera,
         point_lights,
         solver,
+        obj_line: line_of(text, obj_span.start),
+        obj_notes,
     })
 }
 

@@ -88,6 +88,25 @@ impl PointLight {
 pub struct SolverDefaults {
     /// Poisson-disk spacing of the initial samples, scene units.
     pub epsilon: Option<f32>,
+    /// What a reflectance channel of exactly 1 in the MTL file is lowered to.
+    pub max_reflectance: Option<f32>,
+}
+
+/// What a reflectance channel of exactly 1 is lowered to unless the scene file or the caller
+/// says otherwise. Exporters write `Kd 1 1 1` for "white", but nothing real reflects all
+/// light: fresh matte white paint reflects about 0.8–0.9. 0.9 keeps such a white as white as
+/// real materials get, while the light it inter-reflects still fades within tens of bounces
+/// (1/(1 − 0.9) = 10 on average) instead of never.
+pub const DEFAULT_MAX_REFLECTANCE: f32 = 0.9;
+
+/// How a scene file is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LoadOptions {
+    /// What a reflectance channel of exactly 1 is lowered to; overrides the scene file's
+    /// `[solver] max_reflectance` (default [`DEFAULT_MAX_REFLECTANCE`]).
+    pub max_reflectance: Option<f32>,
+    /// A reflectance of exactly 1 is an error instead of being lowered.
+    pub strict: bool,
 }
 
 /// An axis-aligned box.
@@ -183,9 +202,51 @@ impl Scene {
     /// Loads a scene whose files come from `files` (paths as the scene file names them,
     /// relative to its folder).
     pub fn load_from(files: &dyn Source, path: impl AsRef<Path>) -> Result<Scene> {
+        Scene::load_with(files, path, &LoadOptions::default())
+    }
+
+    /// Loads a scene as [`Scene::load_from`], with `options` for what the files may leave
+    /// open (a reflectance of exactly 1).
+    pub fn load_with(
+        files: &dyn Source,
+        path: impl AsRef<Path>,
+        options: &LoadOptions,
+    ) -> Result<Scene> {
         let path = path.as_ref();
         let file = file::read(files, path)?;
-        let (mesh, mut warnings) = obj::read(files, &file.obj)?;
+        let max_reflectance = match options.max_reflectance {
+            Some(r) => match validate::max_reflectance(r) {
+                Some(problem) => {
+                    return Err(Error::Option {
+                        option: "max_reflectance",
+                        problem,
+                    })
+                }
+                None => r,
+            },
+            None => (file.solver.max_reflectance).unwrap_or(DEFAULT_MAX_REFLECTANCE),
+        };
+        let rules = obj::Rules {
+            max_reflectance,
+            strict: options.strict,
+        };
+        let (mesh, mut warnings) = obj::read(files, &file.obj, &rules).map_err(|e| match e {
+            // A generated OBJ not made yet: say what the scene file says about it.
+            Error::Read { path: obj, cause }
+                if cause.kind() == std::io::ErrorKind::NotFound && !file.obj_notes.is_empty() =>
+            {
+                Error::scene(
+                    path,
+                    Some(file.obj_line),
+                    format!(
+                        "{} not found; the scene file says: {}",
+                        obj.display(),
+                        file.obj_notes.join(" ")
+                    ),
+                )
+            }
+            e => e,
+        })?;
         let parts = SceneParts {
             mesh,
             point_lights: file.point_lights,
@@ -250,8 +311,34 @@ impl Scene {
 
     /// The same scene in other units: every length × `s`, point-light intensities × s² (so
     /// irradiance at scaled distances is unchanged) and ε × s. Radiances (Ke) stay, so a
-    /// solve gives the same image.
-    pub fn scaled(&self, s: f32) -> Scene {
+    /// solve gives the same image. `s` must be a positive number that keeps every length and
+    /// area representable.
+    pub fn scaled(&self, s: f32) -> Result<Scene> {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(Error::argument(
+                "scale",
+                format!("{s} is not a positive number"),
+            ));
+        }
+        let largest = self
+            .bounds
+            .min
+            .abs()
+            .max(self.bounds.max.abs())
+            .max_element()
+            * s;
+        let smallest = self
+            .triangles
+            .iter()
+            .map(|t| t.area)
+            .fold(f32::INFINITY, f32::min);
+        let smallest = f64::from(smallest) * f64::from(s) * f64::from(s);
+        if !(largest <= validate::MAX_COORDINATE && smallest >= f64::from(f32::MIN_POSITIVE)) {
+            return Err(Error::argument(
+                "scale",
+                format!("× {s} takes the scene beyond what 32-bit floats hold"),
+            ));
+        }
         let mut scene = self.clone();
         for t in &mut scene.triangles {
             t.vertices = t.vertices.map(|v| v * s);
@@ -272,11 +359,12 @@ impl Scene {
             max: self.bounds.max * s,
         };
         scene.solver.epsilon = self.solver.epsilon.map(|e| e * s);
-        scene
+        Ok(scene)
     }
 
     /// The same scene with every light × `f`: emitted radiance Ke and point-light intensities.
-    pub fn with_lights_scaled(&self, f: f32) -> Scene {
+    /// `f` must be a number ≥ 0 that keeps them finite.
+    pub fn with_lights_scaled(&self, f: f32) -> Result<Scene> {
         let mut scene = self.clone();
         for m in &mut scene.materials {
             m.ke *= f;
@@ -284,7 +372,15 @@ impl Scene {
         for light in &mut scene.point_lights {
             light.intensity *= f;
         }
-        scene
+        let lights = scene.materials.iter().map(|m| m.ke);
+        let lights = lights.chain(scene.point_lights.iter().map(|l| l.intensity));
+        if f.is_nan() || f < 0.0 || !lights.into_iter().all(|v| v.is_finite()) {
+            return Err(Error::argument(
+                "light scale",
+                format!("× {f} does not give finite, non-negative lights"),
+            ));
+        }
+        Ok(scene)
     }
 
     /// The material of a surface.

@@ -26,26 +26,69 @@ const OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
     ignore_lines: true,
 };
 
+/// What the scene format leaves to the reader: reflectances of exactly 1.
+pub(super) struct Rules {
+    /// What a Kd channel of exactly 1 is lowered to.
+    pub max_reflectance: f32,
+    /// Whether such a channel is an error instead.
+    pub strict: bool,
+}
+
 /// Reads an OBJ file and the MTL files it names; returns the mesh and warnings.
-pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<(Mesh, Vec<String>)> {
+pub(super) fn read(
+    files: &dyn super::Source,
+    path: &Path,
+    rules: &Rules,
+) -> Result<(Mesh, Vec<String>)> {
     let text = read_text(files, path)?;
     let prepared = prepare_obj(path, &text)?;
     let dir = path.parent().unwrap_or(Path::new(""));
 
     let libraries: RefCell<Vec<MtlLibrary>> = RefCell::new(Vec::new());
     let failure: RefCell<Option<Error>> = RefCell::new(None);
-    let loader = |name: &Path| -> tobj::MTLLoadResult {
-        let mtl_path = dir.join(name);
-        let outcome = read_mtl(files, &mtl_path).and_then(|library| {
-            let loaded = tobj::load_mtl_buf(&mut library.text.as_bytes())
-                .map_err(|e| Error::scene(&mtl_path, None, format!("MTL parser: {e}")))?;
-            libraries.borrow_mut().push(library);
-            Ok(loaded)
-        });
-        outcome.map_err(|e| {
-            failure.borrow_mut().get_or_insert(e);
-            tobj::LoadError::OpenFileFailed
-        })
+    let missing: RefCell<Vec<String>> = RefCell::new(Vec::new());
+    // tobj hands over the rest of an `mtllib` line as one name: several files are allowed
+    // there (separated by spaces), each read and their materials merged in order.
+    let loader = |names: &Path| -> tobj::MTLLoadResult {
+        let mut merged: (Vec<tobj::Material>, HashMap<String, usize>) = Default::default();
+        let names = names.to_string_lossy();
+        for name in names.split_whitespace() {
+            let mtl_path = dir.join(name);
+            let library = match read_mtl(files, &mtl_path) {
+                Ok(library) => library,
+                Err(Error::Read { cause, .. }) if cause.kind() == std::io::ErrorKind::NotFound => {
+                    let line = prepared.mtllib.iter().find(|(n, _)| n.contains(name));
+                    missing.borrow_mut().push(format!(
+                        "{}:{}: MTL file {} not found: faces with its materials get Kd = \
+                         {DEFAULT_KD} grey",
+                        path.display(),
+                        line.map_or(0, |l| l.1),
+                        mtl_path.display()
+                    ));
+                    continue;
+                }
+                Err(e) => {
+                    failure.borrow_mut().get_or_insert(e);
+                    return Err(tobj::LoadError::OpenFileFailed);
+                }
+            };
+            match tobj::load_mtl_buf(&mut library.text.as_bytes()) {
+                Ok((materials, names)) => {
+                    let offset = merged.0.len();
+                    merged.0.extend(materials);
+                    for (name, index) in names {
+                        merged.1.entry(name).or_insert(index + offset);
+                    }
+                    libraries.borrow_mut().push(library);
+                }
+                Err(e) => {
+                    let e = Error::scene(&mtl_path, None, format!("MTL parser: {e}"));
+                    failure.borrow_mut().get_or_insert(e);
+                    return Err(tobj::LoadError::OpenFileFailed);
+                }
+            }
+        }
+        Ok(merged)
     };
     let loaded = tobj::load_obj_buf(&mut prepared.text.as_bytes(), &OPTIONS, loader);
     if let Some(e) = failure.into_inner() {
@@ -56,9 +99,13 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<(Mesh, Vec<
     let tobj_materials = tobj_materials.unwrap_or_default();
     let libraries = libraries.into_inner();
 
-    let mut warnings = Vec::new();
-    let mut materials = materials_from(&tobj_materials, &libraries, &mut warnings)?;
-    check_usemtl(path, &prepared.usemtl, &materials, &libraries)?;
+    let mut warnings = missing.into_inner();
+    let any_missing = !warnings.is_empty();
+    let mut materials = materials_from(&tobj_materials, &libraries, rules, &mut warnings)?;
+    // A material a missing MTL file may have defined gets the default grey (below).
+    if !any_missing {
+        check_usemtl(path, &prepared.usemtl, &materials, &libraries)?;
+    }
 
     let mut mesh = Mesh::default();
     let mut default_material: Option<u32> = None;
@@ -113,8 +160,13 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<(Mesh, Vec<
 fn read_text(files: &dyn super::Source, path: &Path) -> Result<String> {
     let bytes = files.read(path).map_err(|source| Error::Read {
         path: path.into(),
-        source,
+        cause: source,
     })?;
+    // A UTF-8 byte-order mark (some Windows tools write one) is not part of the first line.
+    let bytes = match bytes.strip_prefix(b"\xEF\xBB\xBF") {
+        Some(rest) => rest.to_vec(),
+        None => bytes,
+    };
     String::from_utf8(bytes).map_err(|e| {
         let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
@@ -131,6 +183,8 @@ struct PreparedObj {
     text: String,
     /// Each `usemtl` name with its line.
     usemtl: Vec<(String, usize)>,
+    /// Each `mtllib` statement's file names with its line.
+    mtllib: Vec<(String, usize)>,
     /// Faces with one or two vertices (points, lines), left out.
     short_faces: usize,
 }
@@ -138,6 +192,7 @@ struct PreparedObj {
 fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
     let mut out = String::with_capacity(text.len());
     let mut usemtl = Vec::new();
+    let mut mtllib = Vec::new();
     let mut short_faces = 0;
     let mut vertices: i64 = 0;
     let mut largest_index: Option<(i64, usize)> = None;
@@ -210,6 +265,8 @@ fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
                 }
                 if keyword == "usemtl" {
                     usemtl.push((name.to_string(), line));
+                } else {
+                    mtllib.push((name.to_string(), line));
                 }
                 out.push_str(keyword);
                 out.push(' ');
@@ -235,6 +292,7 @@ fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
     Ok(PreparedObj {
         text: out,
         usemtl,
+        mtllib,
         short_faces,
     })
 }
@@ -322,6 +380,7 @@ fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibrary> {
 fn materials_from(
     loaded: &[tobj::Material],
     libraries: &[MtlLibrary],
+    rules: &Rules,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<Material>> {
     let lines: Vec<(&Path, &MtlLines)> = libraries
@@ -352,11 +411,34 @@ fn materials_from(
                 ),
             ));
         }
-        let material = Material {
+        let mut material = Material {
             name: t.name.clone(),
             kd: t.diffuse.map(Vec3::from).unwrap_or(Vec3::ZERO),
             ke: t.emissive.map(Vec3::from).unwrap_or(Vec3::ZERO),
         };
+        let kd = material.kd;
+        if kd.to_array().contains(&1.0) {
+            // Many exporters write white as 1: lowered, or refused when asked to be strict.
+            let at_kd = at.kd_line.or(Some(at.line));
+            let said = format!("material '{}': Kd {} {} {}", at.name, kd.x, kd.y, kd.z);
+            if rules.strict {
+                return Err(Error::scene(
+                    path,
+                    at_kd,
+                    format!(
+                        "{said} reflects all light in a channel, which nothing real does (strict)"
+                    ),
+                ));
+            }
+            let r = rules.max_reflectance;
+            material.kd = Vec3::from(kd.to_array().map(|c| if c == 1.0 { r } else { c }));
+            warnings.push(format!(
+                "{}:{}: {said}: a channel of 1 reflects all light, which nothing real does: \
+                 lowered to {r} (max_reflectance; --strict refuses it)",
+                path.display(),
+                at_kd.unwrap_or(at.line),
+            ));
+        }
         if let Some((field, problem)) = validate::material_field(&material) {
             let line = match field {
                 MaterialField::Kd => at.kd_line,

@@ -55,6 +55,12 @@ pub(crate) fn material_field(m: &Material) -> Option<(MaterialField, String)> {
     None
 }
 
+/// Why a `max_reflectance` (what a reflectance of exactly 1 is lowered to) is unusable.
+pub(crate) fn max_reflectance(r: f32) -> Option<String> {
+    (!(r > 0.0 && r < 1.0))
+        .then(|| format!("max_reflectance {r} must lie strictly between 0 and 1"))
+}
+
 /// Why a point light is invalid, if it is.
 pub(crate) fn point_light(l: &PointLight) -> Option<String> {
     if let Some(problem) = position(l.position) {

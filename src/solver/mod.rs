@@ -70,6 +70,48 @@ pub struct Solution {
     pub row_scale: Vec<f32>,
 }
 
+impl Solution {
+    /// Whether this solution belongs to `scene` and its arrays agree with each other: an
+    /// error naming what does not fit, so that rendering or transferring light with a
+    /// solution of another scene (or one a host has edited) fails cleanly.
+    pub fn check_fits(&self, scene: &Scene) -> Result<()> {
+        let fail = |problem: String| Err(Error::argument("solution", problem));
+        let s = &self.samples;
+        let n = s.len();
+        let sides = 2 * scene.surfaces.len();
+        if self.maps.len() != scene.surfaces.len() {
+            return fail(format!(
+                "solved for {} surfaces, the scene has {}",
+                self.maps.len(),
+                scene.surfaces.len()
+            ));
+        }
+        let lengths = [
+            ("normals", s.normal.len()),
+            ("uv", s.uv.len()),
+            ("sides", s.side.len()),
+            ("radii", s.radius.len()),
+            ("areas", s.area.len()),
+            ("radiosities", self.radiosity.len()),
+            ("irradiances", self.irradiance.len()),
+            ("unshot", self.unshot.len()),
+            ("direct", self.direct.len()),
+        ];
+        if let Some((name, len)) = lengths.iter().find(|(_, len)| *len != n) {
+            return fail(format!("{len} {name} for {n} samples"));
+        }
+        if let Some(side) = s.side.iter().find(|&&side| side as usize >= sides) {
+            return fail(format!(
+                "a sample on side {side}; the scene has {sides} sides"
+            ));
+        }
+        if !self.index.fits(sides, n) {
+            return fail("its sample index does not match its samples".into());
+        }
+        Ok(())
+    }
+}
+
 /// Where ε came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
@@ -165,7 +207,9 @@ pub fn solve(
     } else {
         Method::Flat
     };
-    solve_with(scene, vis, options, progress, method)
+    crate::parallel::guarded("the solver", || {
+        solve_with(scene, vis, options, progress, method)
+    })
 }
 
 /// Which shooting solver a solve runs.
@@ -265,7 +309,27 @@ pub fn transfer(
     shooters: &[u32],
     source: DVec3,
 ) -> Result<Vec<DVec3>> {
+    crate::parallel::guarded("the transfer", || {
+        transfer_unguarded(scene, solution, vis, shooters, source)
+    })
+}
+
+/// [`transfer`] without its guard against panics.
+fn transfer_unguarded(
+    scene: &Scene,
+    solution: &Solution,
+    vis: &dyn Visibility,
+    shooters: &[u32],
+    source: DVec3,
+) -> Result<Vec<DVec3>> {
+    solution.check_fits(scene)?;
     let (samples, maps) = (&solution.samples, &solution.maps);
+    if let Some(&j) = shooters.iter().find(|&&j| j as usize >= samples.len()) {
+        return Err(Error::argument(
+            "shooters",
+            format!("sample {j} does not exist ({} samples)", samples.len()),
+        ));
+    }
     let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
     let mut irradiance = vec![DVec3::ZERO; samples.len()];
     for &j in shooters {

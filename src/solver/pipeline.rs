@@ -10,7 +10,6 @@
 
 use std::collections::VecDeque;
 use std::ops::ControlFlow;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::thread::Scope;
 
 use crossbeam_channel::{bounded, Receiver, Sender};
@@ -176,17 +175,7 @@ impl<I: Send, O: Send> Pool<'_, I, O> {
 
 /// Runs one job, turning a panic into an error.
 fn run<I, O>(work: &(dyn Fn(I) -> Result<O> + Sync), job: I) -> Result<O> {
-    match catch_unwind(AssertUnwindSafe(|| work(job))) {
-        Ok(result) => result,
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "a panic without a message".into());
-            Err(worker_error(&format!("a worker panicked: {what}")))
-        }
-    }
+    crate::parallel::guarded("a worker", || work(job))
 }
 
 fn worker_error(problem: &str) -> Error {

@@ -58,7 +58,28 @@ pub struct Hit {
     pub triangle: u32,
 }
 
-/// Answers visibility questions about one scene, a batch at a time, from any number of threads.
+/// Answers visibility questions about one scene, a batch at a time, from any number of threads:
+/// the extension point for a host's own ray caster (`examples/embed.rs` plugs one in).
+///
+/// The contract:
+/// - **Geometry**: the triangles of [`Scene::triangles`] (the loaded scene's order, which is
+///   not the order of the mesh a host handed to [`Scene::from_parts`]: surfaces are grouped),
+///   both sides of each blocking light; a [`Hit`] names its triangle by that index.
+/// - **Segments**: blocked when any triangle crosses `a + t (b − a)` for `t` in
+///   [[`SEGMENT_T_MIN`], [`SEGMENT_T_MAX`]]: the ends never block, so a segment between two
+///   points on surfaces is not blocked by those surfaces.
+/// - **Rays**: the nearest hit with `t` in [`t_min`, `t_max`] (units of the direction's
+///   length, which need not be 1), or `None`.
+/// - **Batches**: any length, including 0 (the library asks up to about 65,000 at once);
+///   `out` has the batch's length and every entry must be written.
+/// - **Threads**: called concurrently from the solver's and renderer's worker threads; answers
+///   must not depend on which thread asks or in which order, or results stop being
+///   deterministic.
+/// - **Failure**: return an error ([`Error::Backend`] is meant for it) and the solve or render
+///   ends with it; a panic ends it with [`Error::Worker`] naming the panic. Never a hang.
+///
+/// [`t_min`]: Ray::t_min
+/// [`t_max`]: Ray::t_max
 pub trait Visibility: Send + Sync {
     /// The backend's name, as `--backend` spells it.
     fn name(&self) -> &'static str;

@@ -91,6 +91,18 @@ pub fn patch_radiosity(
     options: &PatchOptions,
     progress: &mut dyn FnMut(PatchProgress) -> Control,
 ) -> Result<PatchImage> {
+    crate::parallel::guarded("the patch solver", || {
+        patch_radiosity_unguarded(scene, vis, options, progress)
+    })
+}
+
+/// [`patch_radiosity`] without its guard against panics.
+fn patch_radiosity_unguarded(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &PatchOptions,
+    progress: &mut dyn FnMut(PatchProgress) -> Control,
+) -> Result<PatchImage> {
     let size = options.patch_size;
     if !(size.is_finite() && size > 0.0) {
         return Err(Error::Option {
