@@ -50,12 +50,18 @@ struct ml_scene {
 
 int ml_embree_major(void) { return ML_EMBREE_MAJOR; }
 
+/* The message of the last error Embree reported on this thread: a query's error is the
+ * calling thread's own (Embree keeps an error code per device and thread), never another
+ * thread's or an earlier call's. */
+static _Thread_local char thread_error[256];
+
 static void on_device_error(void *user, enum RTCError code, const char *str) {
   ml_scene *s = (ml_scene *)user;
   int expected = 0;
   if (s == NULL || code == RTC_ERROR_NONE) {
     return;
   }
+  snprintf(thread_error, sizeof thread_error, "Embree error %d: %s", (int)code, str ? str : "");
   if (atomic_compare_exchange_strong(&s->error_claimed, &expected, 1)) {
     snprintf(s->error, sizeof s->error, "Embree error %d: %s", (int)code, str ? str : "");
     atomic_store(&s->error_ready, 1);
@@ -112,14 +118,27 @@ ml_scene *ml_scene_new(const float *vertices, size_t nv, const uint32_t *indices
                                                      RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv);
         uint32_t *ib = (uint32_t *)rtcSetNewGeometryBuffer(
             g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), nt);
-        if (vb != NULL && ib != NULL) {
-          memcpy(vb, vertices, 3 * nv * sizeof(float));
-          memcpy(ib, indices, 3 * nt * sizeof(uint32_t));
+        if (vb == NULL || ib == NULL) {
+          /* A failed allocation: neither commit nor attach a geometry without its buffers. */
+          rtcReleaseGeometry(g);
+          ML_FTZ_END;
+          write_err(err, errlen,
+                    atomic_load(&s->error_ready) ? s->error
+                                                 : "Embree could not allocate the geometry buffers");
+          ml_scene_free(s);
+          return NULL;
         }
+        memcpy(vb, vertices, 3 * nv * sizeof(float));
+        memcpy(ib, indices, 3 * nt * sizeof(uint32_t));
         rtcSetGeometryBuildQuality(g, q);
         rtcCommitGeometry(g);
         rtcAttachGeometry(s->scene, g);
         rtcReleaseGeometry(g);
+      } else {
+        ML_FTZ_END;
+        write_err(err, errlen, atomic_load(&s->error_ready) ? s->error : "rtcNewGeometry failed");
+        ml_scene_free(s);
+        return NULL;
       }
     }
     rtcCommitScene(s->scene);
@@ -348,8 +367,28 @@ static void intersect_stream(RTCScene sc, ml_args *a, const ml_ray *rays, size_t
 }
 #endif
 
+/* Before a query: forget this thread's earlier error on the device. */
+static void status_before(const ml_scene *s) {
+  thread_error[0] = '\0';
+  (void)rtcGetDeviceError(s->device);
+}
+
+/* After a query: this thread's error on the device during the call, if any (and it is reset). */
 static int status_after(const ml_scene *s) {
-  return atomic_load(&((ml_scene *)s)->error_ready) ? ML_ERR_EMBREE : ML_OK;
+  enum RTCError code = rtcGetDeviceError(s->device);
+  if (code == RTC_ERROR_NONE) {
+    return ML_OK;
+  }
+  if (thread_error[0] == '\0') {
+    snprintf(thread_error, sizeof thread_error, "Embree error %d", (int)code);
+  }
+  return ML_ERR_EMBREE;
+}
+
+void ml_thread_error(char *buf, size_t len) {
+  if (buf != NULL && len > 0) {
+    snprintf(buf, len, "%s", thread_error);
+  }
 }
 
 int ml_occluded(const ml_scene *s, const ml_segment *segs, size_t n, float t_min, float t_max,
@@ -367,6 +406,7 @@ int ml_occluded(const ml_scene *s, const ml_segment *segs, size_t n, float t_min
   }
   ml_args a;
   ml_args_init(&a);
+  status_before(s);
   ML_FTZ_BEGIN;
   switch (mode) {
   case ML_MODE_SINGLE:
@@ -407,6 +447,7 @@ int ml_intersect(const ml_scene *s, const ml_ray *rays, size_t n, int mode, ml_h
   }
   ml_args a;
   ml_args_init(&a);
+  status_before(s);
   ML_FTZ_BEGIN;
   switch (mode) {
   case ML_MODE_SINGLE:

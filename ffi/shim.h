@@ -45,7 +45,7 @@ enum ml_mode {
 /* Return codes. */
 enum ml_status {
   ML_OK = 0,
-  ML_ERR_EMBREE = 1,      /* Embree reported an error: ml_scene_error() has its text */
+  ML_ERR_EMBREE = 1,      /* Embree reported an error: ml_thread_error() has its text */
   ML_ERR_UNSUPPORTED = 2, /* the mode does not exist in this Embree version */
   ML_ERR_ARGUMENT = 3     /* a null pointer or an out-of-range value */
 };
@@ -71,6 +71,10 @@ void ml_scene_free(ml_scene *scene);
 
 /* The first error Embree reported on this scene's device since it was built (empty if none). */
 void ml_scene_error(const ml_scene *scene, char *buf, size_t len);
+
+/* The error Embree reported on the calling thread during its last ml_occluded or ml_intersect
+ * that returned ML_ERR_EMBREE (empty if none). */
+void ml_thread_error(char *buf, size_t len);
 
 /* For each segment, whether a triangle lies on it within [t_min, t_max]; out[i] true = blocked. */
 int ml_occluded(const ml_scene *scene, const ml_segment *segments, size_t n, float t_min,

@@ -5,11 +5,12 @@
 //!
 //! The data flows scene → visibility → samples → areas → solver → render:
 //!
-//! ```no_run
+//! ```
 //! use meshlight::solver::{Control, Options};
 //! use meshlight::{Backend, RenderOptions, Scene};
 //!
-//! let scene = Scene::load("scenes/room/scene.toml")?;
+//! // The furnace: a closed cube whose faces all emit Ke 0.1 and reflect Kd 0.5.
+//! let scene = Scene::load("scenes/box/scene.toml")?;
 //! let vis = Backend::default_backend().build(&scene)?;
 //! let options = Options { rounds: 1, ..Options::default() };
 //! let solution = meshlight::solve(&scene, vis.as_ref(), &options, &mut |progress| {
@@ -17,7 +18,9 @@
 //!     if progress.shots > 100_000 { Control::Stop } else { Control::Continue }
 //! })?;
 //! let (image, _stats) = meshlight::render(&scene, &solution, vis.as_ref(), &RenderOptions::default())?;
-//! image.write_exr("room.exr".as_ref())?;
+//! // Everywhere the radiance Ke / (1 − Kd) = 0.2.
+//! assert!((image.mean() - 0.2).abs() < 0.002, "{}", image.mean());
+//! image.write_exr(&std::env::temp_dir().join("meshlight-furnace.exr"))?;
 //! # Ok::<(), meshlight::Error>(())
 //! ```
 

@@ -89,7 +89,7 @@ impl DirectLight {
             emitters,
             points,
             light_samples: light_samples.max(1),
-            lift: crate::visibility::workload::LIFT * scene.bounds.diagonal(),
+            lift: crate::visibility::lift(scene),
         }
     }
 

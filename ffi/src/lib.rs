@@ -73,17 +73,20 @@ pub const ML_MODE_STREAM: c_int = 4;
 
 /// Success.
 pub const ML_OK: c_int = 0;
-/// Embree reported an error; `ml_scene_error` has its text.
+/// Embree reported an error on the calling thread during the call; `ml_thread_error` has its
+/// text.
 pub const ML_ERR_EMBREE: c_int = 1;
 /// The mode does not exist in this Embree version.
 pub const ML_ERR_UNSUPPORTED: c_int = 2;
 /// A null pointer or out-of-range argument.
 pub const ML_ERR_ARGUMENT: c_int = 3;
 
-/// Opaque scene handle (device + committed scene).
+/// Opaque scene handle (device + committed scene). Neither `Send` nor `Sync` by itself (the
+/// marker): a wrapper that shares it across threads must say why that is sound.
 #[repr(C)]
 pub struct ml_scene {
     _private: [u8; 0],
+    _marker: core::marker::PhantomData<(*mut u8, core::marker::PhantomPinned)>,
 }
 
 extern "C" {
@@ -104,6 +107,9 @@ extern "C" {
     pub fn ml_scene_free(scene: *mut ml_scene);
     /// Copies the first device error (or an empty string) into `buf`.
     pub fn ml_scene_error(scene: *const ml_scene, buf: *mut c_char, len: usize);
+    /// Copies the error Embree reported on the calling thread during its last failed query
+    /// (or an empty string) into `buf`.
+    pub fn ml_thread_error(buf: *mut c_char, len: usize);
     /// Batched occlusion of segments over parameters `[t_min, t_max]`.
     pub fn ml_occluded(
         scene: *const ml_scene,

@@ -289,12 +289,7 @@ pub fn solve_setup(
 
 /// Options from a preset and the command line's knobs.
 pub fn options_from(epsilon: Option<f32>, args: &crate::Knobs) -> anyhow::Result<Options> {
-    let mut o = match args.preset.as_str() {
-        "preview" => Options::preview(),
-        "default" => Options::default(),
-        "final" => Options::final_quality(),
-        other => anyhow::bail!("unknown --preset '{other}' (known: preview, default, final)"),
-    };
+    let mut o = args.preset.parse::<meshlight::solver::Preset>()?.options();
     o.epsilon = epsilon.or(o.epsilon);
     o.zeta = args.zeta.unwrap_or(o.zeta);
     o.alpha = args.alpha.unwrap_or(o.alpha);

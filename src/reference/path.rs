@@ -19,7 +19,6 @@ use crate::error::{Error, Result};
 use crate::parallel::for_chunks;
 use crate::render::Image;
 use crate::scene::Scene;
-use crate::visibility::workload::LIFT;
 use crate::visibility::{Hit, Ray, Segment, Visibility};
 
 /// Path tracing settings.
@@ -193,7 +192,7 @@ fn path_trace_unguarded(
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let pixels = w * h;
     let lights = Lights::new(scene);
-    let lift = LIFT * scene.bounds.diagonal();
+    let lift = crate::visibility::lift(scene);
     let threads = options.threads.max(1);
     // Per pixel: sums of the even and of the odd samples.
     let mut sums = vec![[DVec3::ZERO; 2]; pixels];

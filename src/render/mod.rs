@@ -202,7 +202,7 @@ impl<'a> Shader<'a> {
             scene,
             solution,
             vis,
-            lift: crate::visibility::workload::LIFT * scene.bounds.diagonal(),
+            lift: crate::visibility::lift(scene),
             support,
         }
     }

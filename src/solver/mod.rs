@@ -29,7 +29,7 @@ use crate::sampling::{reflecting_sides, surface_of, Obstruction, Samples, SideIn
 use crate::scene::Scene;
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
-pub use options::{Options, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD};
+pub use options::{Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD};
 use phases::{AddedSamples, Solve};
 pub use progress::{Control, Phase, Progress};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
@@ -241,7 +241,7 @@ fn solve_with(
             ),
         });
     }
-    let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
+    let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
     let obstruction = Obstruction::new(scene, &maps, lift);
     let mut solve = Solve {
@@ -330,7 +330,7 @@ fn transfer_unguarded(
             format!("sample {j} does not exist ({} samples)", samples.len()),
         ));
     }
-    let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
+    let lift = crate::visibility::lift(scene);
     let mut irradiance = vec![DVec3::ZERO; samples.len()];
     for &j in shooters {
         for (i, f) in flat::form_factors(samples, maps, vis, lift, j as usize)? {
@@ -446,7 +446,7 @@ mod tests {
         };
         let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
         let grid = TriangleGrid::new(&scene);
-        let lift = crate::visibility::workload::LIFT * scene.bounds.diagonal();
+        let lift = crate::visibility::lift(&scene);
         let cx = Context {
             scene: &scene,
             grid: &grid,

@@ -113,3 +113,76 @@ impl Options {
         }
     }
 }
+
+/// A starting point for [`Options`], as `--preset` names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Preset {
+    /// [`Options::preview`].
+    Preview,
+    /// [`Options::default`].
+    Default,
+    /// [`Options::final_quality`].
+    Final,
+}
+
+impl Preset {
+    /// Every preset, fastest first.
+    pub const ALL: [Preset; 3] = [Preset::Preview, Preset::Default, Preset::Final];
+
+    /// The preset's name, as `--preset` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Preview => "preview",
+            Preset::Default => "default",
+            Preset::Final => "final",
+        }
+    }
+
+    /// The options it stands for.
+    pub fn options(self) -> Options {
+        match self {
+            Preset::Preview => Options::preview(),
+            Preset::Default => Options::default(),
+            Preset::Final => Options::final_quality(),
+        }
+    }
+}
+
+impl std::str::FromStr for Preset {
+    type Err = crate::Error;
+
+    fn from_str(s: &str) -> crate::Result<Preset> {
+        Preset::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| crate::Error::Option {
+                option: "preset",
+                problem: format!("unknown '{s}' (known: preview, default, final)"),
+            })
+    }
+}
+
+impl std::fmt::Display for Preset {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_parse_by_name_and_refuse_others() {
+        for p in Preset::ALL {
+            assert_eq!(p.name().parse::<Preset>().unwrap(), p);
+        }
+        assert_eq!(Preset::Preview.options().rounds, 0);
+        assert_eq!(Preset::Final.options(), Options::final_quality());
+        let e = "fast".parse::<Preset>().unwrap_err().to_string();
+        assert!(
+            e.contains("unknown 'fast' (known: preview, default, final)"),
+            "{e}"
+        );
+    }
+}

@@ -103,7 +103,9 @@ pub struct EmbreeScene {
 }
 
 // SAFETY: a committed Embree scene is immutable and Embree documents rtcOccluded*/rtcIntersect*
-// as safe to call from any number of threads at once; the shim's error slot is atomic.
+// as safe to call from any number of threads at once; each query reads and resets only its own
+// thread's error code (rtcGetDeviceError is per device and thread), and the message is kept in
+// thread-local storage; the build-time error slot is atomic.
 unsafe impl Send for EmbreeScene {}
 // SAFETY: as above; no method takes &mut self except Drop.
 unsafe impl Sync for EmbreeScene {}
@@ -221,8 +223,9 @@ impl EmbreeScene {
             sys::ML_ERR_ARGUMENT => "invalid arguments to the shim".to_string(),
             _ => {
                 let mut buf = [0 as c_char; 512];
-                // SAFETY: buf is writable for its length; the shim NUL-terminates it.
-                unsafe { sys::ml_scene_error(self.raw.as_ptr(), buf.as_mut_ptr(), buf.len()) };
+                // SAFETY: buf is writable for its length; the shim NUL-terminates it. The
+                // message is this thread's, from the call that just failed.
+                unsafe { sys::ml_thread_error(buf.as_mut_ptr(), buf.len()) };
                 // SAFETY: NUL-terminated by the call above.
                 unsafe { CStr::from_ptr(buf.as_ptr()) }
                     .to_string_lossy()

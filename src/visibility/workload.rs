@@ -85,7 +85,7 @@ impl<'a> SurfacePointSampler<'a> {
 /// that 100·n draws do not find them.
 pub fn facing_segments(scene: &Scene, n: usize, seed: u64) -> Vec<Segment> {
     let sampler = SurfacePointSampler::new(scene);
-    let lift = LIFT * scene.bounds.diagonal();
+    let lift = crate::visibility::lift(scene);
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
     let mut segments = Vec::with_capacity(n);
     for _ in 0..n.saturating_mul(100) {

@@ -12,7 +12,6 @@ use crate::error::{Error, Result};
 use crate::render::Image;
 use crate::scene::Scene;
 use crate::solver::Control;
-use crate::visibility::workload::LIFT;
 use crate::visibility::Visibility;
 
 /// Most rays per side of a pixel when rendering patches.
@@ -166,7 +165,7 @@ fn patch_radiosity_unguarded(
     }
     let meshing = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
-    let lift = LIFT * scene.bounds.diagonal();
+    let lift = crate::visibility::lift(scene);
     let mut state: Vec<solve::PatchState> = mesh
         .patches
         .iter()
