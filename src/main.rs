@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use meshlight::visibility::bench::BenchOptions;
+use cli::bench::BenchOptions;
 use meshlight::{Backend, Scene};
 
 /// Meshless diffuse inter-reflection for rooms, galleries and other interiors.
@@ -66,6 +66,10 @@ struct Knobs {
     /// Refuse to place more samples than this.
     #[arg(long)]
     max_samples: Option<usize>,
+    /// The memory budget every large structure counts against: bytes, or with a K, M or G
+    /// suffix (binary units), e.g. 512M, 8G (default 8G).
+    #[arg(long, value_parser = cli::parse_bytes)]
+    memory_budget: Option<usize>,
     /// Cluster hierarchy error threshold, relative to the mean radiosity (0: the flat solver).
     #[arg(long)]
     cluster_threshold: Option<f64>,
@@ -281,7 +285,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         } => {
             let started = std::time::Instant::now();
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
-            let vis = options.backend.build(&scene)?;
+            let vis = cli::backend_from(&solve.knobs).build(&scene)?;
             if method == Method::Pathtrace {
                 let path_options = meshlight::reference::PathOptions {
                     spp,
@@ -297,7 +301,13 @@ fn run(args: Args) -> anyhow::Result<()> {
                 traced.image.write_png(&png, traced.image.auto_exposure())?;
                 print!(
                     "{}",
-                    cli::reference::path_summary(&scene, &traced, &path_options, &options)
+                    cli::reference::path_summary(
+                        &scene,
+                        &traced,
+                        &path_options,
+                        &options,
+                        vis.name()
+                    )
                 );
                 println!(
                     "total {:.2} s{}; wrote {} and {}",
@@ -331,7 +341,13 @@ fn run(args: Args) -> anyhow::Result<()> {
                 solved.image.write_png(&png, solved.image.auto_exposure())?;
                 print!(
                     "{}",
-                    cli::reference::patch_summary(&scene, &solved, &patch_options, &options)
+                    cli::reference::patch_summary(
+                        &scene,
+                        &solved,
+                        &patch_options,
+                        &options,
+                        vis.name()
+                    )
                 );
                 println!(
                     "total {:.2} s; wrote {} and {}",
@@ -353,7 +369,10 @@ fn run(args: Args) -> anyhow::Result<()> {
             image.write_exr(&output)?;
             let png = output.with_extension("png");
             image.write_png(&png, image.auto_exposure())?;
-            print!("{}", cli::solve_summary(&scene, &solution, &options));
+            print!(
+                "{}",
+                cli::solve_summary(&scene, &solution, &options, vis.name())
+            );
             print!("{}", cli::render_summary(&image, &stats, render_seconds));
             println!(
                 "total {:.2} s{}; wrote {} and {}",
@@ -435,7 +454,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
         Command::Samples { solve, output } => {
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
-            let vis = options.backend.build(&scene)?;
+            let vis = cli::backend_from(&solve.knobs).build(&scene)?;
             let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
             let mean = solution
                 .radiosity
@@ -446,7 +465,10 @@ fn run(args: Args) -> anyhow::Result<()> {
                 / std::f64::consts::PI;
             let exposure = if mean > 0.0 { (0.4 / mean) as f32 } else { 1.0 };
             meshlight::ply::write_samples(&solution, &output, exposure)?;
-            print!("{}", cli::solve_summary(&scene, &solution, &options));
+            print!(
+                "{}",
+                cli::solve_summary(&scene, &solution, &options, vis.name())
+            );
             println!(
                 "wrote {} ({} samples)",
                 output.display(),
@@ -460,7 +482,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             knobs,
         } => {
             let (scene, options) = cli::solve_setup(&scene, None, &knobs)?;
-            let vis = options.backend.build(&scene)?;
+            let vis = cli::backend_from(&knobs).build(&scene)?;
             cli::scale::run(&scene, vis.as_ref(), &options, &epsilon, flat_limit)?;
         }
         Command::Info { scene } => {
@@ -493,7 +515,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                 repeats,
                 seed,
             };
-            let report = meshlight::visibility::bench::run(&scene, &options, &mut |step| {
+            let report = cli::bench::run(&scene, &options, &mut |step| {
                 eprintln!("  {step}...");
             })?;
             print!("{}", cli::bench_report(&scene, &report));

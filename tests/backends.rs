@@ -5,8 +5,8 @@
 
 use std::path::PathBuf;
 
-use meshlight::visibility::bench::{intersect_all, occluded_all};
 use meshlight::visibility::workload::{camera_rays, facing_segments};
+use meshlight::visibility::{intersect_all, occluded_all};
 use meshlight::visibility::{BvhPreset, BvhScene, EmbreeOptions, EmbreeScene, Hit, Ray, Segment};
 use meshlight::Scene;
 

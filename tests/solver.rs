@@ -51,7 +51,6 @@ fn meshless_flux(scene: &Scene, source: u32, receiver: u32) -> Vec<f64> {
                 scene,
                 vis.as_ref(),
                 &Options {
-                    backend,
                     rounds: 0,
                     ..Options::default()
                 },

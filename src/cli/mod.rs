@@ -1,5 +1,6 @@
 //! What the CLI prints: text renderings of the library's reports.
 
+pub mod bench;
 pub mod memory;
 pub mod plot;
 pub mod reference;
@@ -14,8 +15,8 @@ use meshlight::render::RenderStats;
 use meshlight::solver::{Control, EpsilonSource, Options, Phase, Progress, StopReason};
 use meshlight::{Image, Solution, Visibility};
 
+use bench::{BenchReport, Rate};
 use glam::{DVec3, Vec3};
-use meshlight::visibility::bench::{BenchReport, Rate};
 use meshlight::visibility::BvhPreset;
 use meshlight::Scene;
 
@@ -287,6 +288,37 @@ pub fn solve_setup(
     Ok((scene, options_from(epsilon, args)?))
 }
 
+/// A size in bytes: a number with an optional K, M or G suffix (binary units).
+pub fn parse_bytes(text: &str) -> Result<usize, String> {
+    let t = text.trim();
+    let (number, unit) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => (&t[..i], c.to_ascii_uppercase()),
+        _ => (t, 'B'),
+    };
+    let scale: f64 = match unit {
+        'B' => 1.0,
+        'K' => 1024.0,
+        'M' => 1024.0 * 1024.0,
+        'G' => 1024.0 * 1024.0 * 1024.0,
+        _ => return Err(format!("'{text}': the unit must be K, M or G")),
+    };
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a size (e.g. 512M, 8G)"))?;
+    let bytes = value * scale;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < usize::MAX as f64) {
+        return Err(format!("'{text}' is not a positive size"));
+    }
+    Ok(bytes as usize)
+}
+
+/// The visibility backend the command line asks for (default: Embree if built in).
+pub fn backend_from(args: &crate::Knobs) -> meshlight::Backend {
+    args.backend
+        .unwrap_or_else(meshlight::Backend::default_backend)
+}
+
 /// Options from a preset and the command line's knobs.
 pub fn options_from(epsilon: Option<f32>, args: &crate::Knobs) -> anyhow::Result<Options> {
     let mut o = args.preset.parse::<meshlight::solver::Preset>()?.options();
@@ -298,9 +330,9 @@ pub fn options_from(epsilon: Option<f32>, args: &crate::Knobs) -> anyhow::Result
     o.tolerance = args.tolerance.unwrap_or(o.tolerance);
     o.max_shots = args.max_shots.or(o.max_shots);
     o.max_samples = args.max_samples.unwrap_or(o.max_samples);
+    o.memory_budget = args.memory_budget.unwrap_or(o.memory_budget);
     o.cluster_threshold = args.cluster_threshold.unwrap_or(o.cluster_threshold);
     o.exact_visibility |= args.exact_visibility;
-    o.backend = args.backend.unwrap_or(o.backend);
     o.threads = args.threads.unwrap_or(o.threads).max(1);
     o.seed = args.seed.unwrap_or(o.seed);
     Ok(o)
@@ -386,7 +418,7 @@ fn progress_line(p: &Progress, eta: Option<Duration>) -> String {
 }
 
 /// The solve's summary: samples per round, shots, queries, unshot fraction, time per phase.
-pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
+pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) -> String {
     let mut out = String::new();
     let source = match s.epsilon_source {
         EpsilonSource::Options => "command line",
@@ -400,7 +432,7 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
         scene.path.display(),
         scene.triangles.len(),
         scene.surfaces.len(),
-        o.backend,
+        backend,
         o.threads,
         s.epsilon,
         o.alpha,
@@ -463,15 +495,18 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options) -> String {
         );
     }
     let bytes: u64 = s.rounds.iter().map(|r| r.shooting.bytes).max().unwrap_or(0);
+    let samples_bytes: u64 = s.rounds.iter().map(|r| r.solution_bytes).max().unwrap_or(0);
     let _ = writeln!(
         out,
-        "solver: {}; links and caches held at most {}",
+        "solver: {}; samples held at most {}, links and caches {}, of a {} budget",
         if o.cluster_threshold > 0.0 {
             format!("cluster hierarchy, threshold {}", o.cluster_threshold)
         } else {
             "flat (every sample to every sample)".into()
         },
-        memory::human(bytes),
+        meshlight::solver::human_bytes(samples_bytes as f64),
+        meshlight::solver::human_bytes(bytes as f64),
+        meshlight::solver::human_bytes(o.memory_budget as f64),
     );
     if s.stop() == StopReason::ShotLimit {
         let _ = writeln!(
@@ -489,4 +524,20 @@ pub fn render_summary(image: &Image, stats: &RenderStats, seconds: f64) -> Strin
         "render {}x{}: {} camera rays ({} edge pixels supersampled), {} interpolation queries, {:.3} s; mean radiance {:.5}\n",
         image.width, image.height, stats.camera_rays, stats.supersampled_pixels, stats.interpolation_queries, seconds, image.mean()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_bytes;
+
+    #[test]
+    fn sizes_parse_in_binary_units() {
+        assert_eq!(parse_bytes("1000"), Ok(1000));
+        assert_eq!(parse_bytes("512M"), Ok(512 << 20));
+        assert_eq!(parse_bytes("8g"), Ok(8 << 30));
+        assert_eq!(parse_bytes("1.5K"), Ok(1536));
+        for bad in ["", "G", "-1G", "0", "4X", "lots"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
+    }
 }

@@ -49,13 +49,14 @@ pub fn path_summary(
     traced: &meshlight::reference::PathImage,
     path: &meshlight::reference::PathOptions,
     o: &Options,
+    backend: &str,
 ) -> String {
     format!(
         "scene {}: {} triangles; backend {}, {} thread(s); path tracing, seed {}\n\
          path tracer {}x{}: {} samples per pixel, {} rays; mean radiance {:.5}; noise estimate {:.3}% (MAE/mean between the even and odd half-images / 2)\n",
         scene.path.display(),
         scene.triangles.len(),
-        o.backend,
+        backend,
         o.threads,
         path.seed,
         traced.image.width,
@@ -100,6 +101,7 @@ pub fn patch_summary(
     solved: &meshlight::reference::PatchImage,
     patch: &meshlight::reference::PatchOptions,
     o: &Options,
+    backend: &str,
 ) -> String {
     format!(
         "scene {}: {} triangles; backend {}, {} thread(s); patches of side {}\n\
@@ -107,7 +109,7 @@ pub fn patch_summary(
          render {}x{}: {} rays per pixel; mean radiance {:.5}\n",
         scene.path.display(),
         scene.triangles.len(),
-        o.backend,
+        backend,
         o.threads,
         patch.patch_size,
         solved.patches,

@@ -41,7 +41,7 @@ pub fn run(
         scene.triangles.len(),
         options.threads,
         options.rounds,
-        options.backend
+        vis.name()
     );
     println!(
         "{:<6} {:>8} {:>9} {:>11} {:>13} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>10}",

@@ -121,6 +121,8 @@ struct Extra {
     spp: u32,
     /// Errors on averages over blocks of this many pixels a side.
     block: u32,
+    /// The visibility backend.
+    backend: Backend,
 }
 
 fn value<T: FromStr>(key: &str, v: &str) -> Result<T> {
@@ -142,7 +144,9 @@ fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
         "max-samples" => o.max_samples = value(key, v)?,
         "cluster-threshold" => o.cluster_threshold = value(key, v)?,
         "exact-visibility" => o.exact_visibility = value(key, v)?,
-        "backend" => o.backend = Backend::from_str(v).map_err(|e| anyhow!("--vary {key}: {e}"))?,
+        "backend" => {
+            extra.backend = Backend::from_str(v).map_err(|e| anyhow!("--vary {key}: {e}"))?
+        }
         "threads" => o.threads = value::<usize>(key, v)?.max(1),
         "seed" => o.seed = value(key, v)?,
         "supersample" => extra.supersample = value::<u32>(key, v)?.max(1),
@@ -222,6 +226,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             patch_size: sweep.patch_size,
             spp: sweep.spp,
             block: sweep.block,
+            backend: super::backend_from(&sweep.knobs),
         };
         for (k, v) in point {
             apply(k, v, &mut options, &mut extra)?;
@@ -246,7 +251,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
     let mut backends: HashMap<Backend, Box<dyn Visibility>> = HashMap::new();
     let mut rows = Vec::new();
     for (i, (point, options, extra)) in runs.iter().enumerate() {
-        let vis = built(&mut backends, &scene, options.backend)?;
+        let vis = built(&mut backends, &scene, extra.backend)?;
         let mut row = measure(&scene, vis, reference, sweep.method, options, extra)?;
         row.settings = point.iter().map(|(_, v)| v.clone()).collect();
         println!(
@@ -279,7 +284,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
         // A reference is usually path traced with the same seed: its samples would then
         // include the curve's own, and the curve would meet it too soon. Another stream.
         options.seed = options.seed.wrapping_add(CURVE_SEED);
-        let vis = built(&mut backends, &scene, options.backend)?;
+        let vis = built(&mut backends, &scene, super::backend_from(&sweep.knobs))?;
         let mut spp = 2u32;
         while spp <= sweep.max_spp.max(2) {
             let extra = Extra {
@@ -287,6 +292,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
                 patch_size: None,
                 spp,
                 block: sweep.block,
+                backend: super::backend_from(&sweep.knobs),
             };
             let row = measure(&scene, vis, reference, Method::Pathtrace, &options, &extra)?;
             println!(

@@ -107,6 +107,21 @@ impl Samples {
         self.round.push(round);
     }
 
+    /// Bytes the samples hold (their arrays' capacities), for the memory budget.
+    pub fn bytes(&self) -> usize {
+        vec_bytes(&self.position)
+            + vec_bytes(&self.normal)
+            + vec_bytes(&self.uv)
+            + vec_bytes(&self.side)
+            + vec_bytes(&self.radius)
+            + vec_bytes(&self.area)
+            + vec_bytes(&self.centroid)
+            + vec_bytes(&self.shares)
+            + vec_bytes(&self.share_start)
+            + vec_bytes(&self.cells)
+            + vec_bytes(&self.round)
+    }
+
     /// Total area of the samples of each of `sides` sides (index: side id); an error if a
     /// sample lies on a side beyond them.
     pub fn area_per_side(&self, sides: usize) -> crate::Result<Vec<f64>> {
@@ -158,7 +173,17 @@ pub struct SideIndex {
     entries: Vec<u32>,
 }
 
+/// Bytes a vector holds.
+pub(crate) fn vec_bytes<T>(v: &Vec<T>) -> usize {
+    v.capacity() * std::mem::size_of::<T>()
+}
+
 impl SideIndex {
+    /// Bytes the index holds.
+    pub fn bytes(&self) -> usize {
+        vec_bytes(&self.grids) + vec_bytes(&self.starts) + vec_bytes(&self.entries)
+    }
+
     /// Whether the index holds no more sides than `sides` and only samples below `samples`
     /// (so queries on a solution a host has edited cannot reach past its arrays).
     pub fn fits(&self, sides: usize, samples: usize) -> bool {

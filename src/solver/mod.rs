@@ -29,7 +29,10 @@ use crate::sampling::{reflecting_sides, surface_of, Obstruction, Samples, SideIn
 use crate::scene::Scene;
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
-pub use options::{Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD};
+pub use options::{
+    Options, Preset, AUTO_SAMPLES, BYTES_PER_SAMPLE, DEFAULT_CLUSTER_THRESHOLD,
+    DEFAULT_MEMORY_BUDGET,
+};
 use phases::{AddedSamples, Solve};
 pub use progress::{Control, Phase, Progress};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
@@ -71,6 +74,26 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// Bytes the solution holds: samples, their index, and per-sample results (the part of
+    /// the memory budget that grows with the samples).
+    pub fn bytes(&self) -> usize {
+        use crate::sampling::vec_bytes;
+        self.samples.bytes()
+            + self.index.bytes()
+            + vec_bytes(&self.radiosity)
+            + vec_bytes(&self.irradiance)
+            + vec_bytes(&self.unshot)
+            + vec_bytes(&self.direct)
+            + vec_bytes(&self.closed)
+            + vec_bytes(&self.covered)
+            + vec_bytes(&self.row_scale)
+            + self
+                .maps
+                .iter()
+                .map(|m| vec_bytes(&m.triangles))
+                .sum::<usize>()
+    }
+
     /// Whether this solution belongs to `scene` and its arrays agree with each other: an
     /// error naming what does not fit, so that rendering or transferring light with a
     /// solution of another scene (or one a host has edited) fails cleanly.
@@ -241,6 +264,19 @@ fn solve_with(
             ),
         });
     }
+    let predicted_bytes = predicted * BYTES_PER_SAMPLE as f64;
+    if predicted_bytes > options.memory_budget as f64 / 2.0 {
+        return Err(Error::Option {
+            option: "memory_budget",
+            problem: format!(
+                "ε = {epsilon} would place about {predicted:.0} samples, predicted to take {} \
+                 ({BYTES_PER_SAMPLE} bytes each), more than half the memory budget of {} (the \
+                 other half is for links and caches; raise --memory-budget or choose a larger ε)",
+                human_bytes(predicted_bytes),
+                human_bytes(options.memory_budget as f64)
+            ),
+        });
+    }
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
     let obstruction = Obstruction::new(scene, &maps, lift);
@@ -338,6 +374,22 @@ fn transfer_unguarded(
         }
     }
     Ok(irradiance)
+}
+
+/// Bytes in binary units, for messages: "3.2 GiB".
+pub fn human_bytes(bytes: f64) -> String {
+    const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
+    let mut value = bytes;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{value:.0} bytes")
+    } else {
+        format!("{value:.1} {}", UNITS[unit])
+    }
 }
 
 fn check(options: &Options) -> Result<()> {

@@ -1,7 +1,5 @@
 //! Every knob of the solver in one documented struct, with named presets.
 
-use crate::visibility::Backend;
-
 /// Solver settings. Each field says what it does, its useful range, and its effect on error and
 /// time; `docs` measurements are in the README.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,10 +44,14 @@ pub struct Options {
     /// 99th-percentile pixel error against the flat solve of 1.4% instead of 4.7%; at 179k
     /// samples 91 M links and 2.4 GB instead of 4.4 M and 0.7 GB.
     pub exact_visibility: bool,
-    /// Memory the flat solver may use to keep each shooter's visible receivers and form
-    /// factors (bytes; 0 disables): re-shooting a kept sample costs no visibility query.
-    /// Results do not depend on it, only time.
-    pub cache_bytes: usize,
+    /// The memory budget, bytes: every large structure counts against it. The samples and
+    /// their results are predicted before they are placed ([`BYTES_PER_SAMPLE`] each) and a
+    /// solve that would not fit is refused before allocating; adaptive rounds stop adding
+    /// samples at half of it; the rest is for the hierarchy's links (a solve whose links
+    /// outgrow it ends with an error) or the flat solver's visibility memo (N²/8 bytes, left
+    /// out if it does not fit in half the rest) and its kept form factors (as many as fit).
+    /// Within the budget, results do not depend on it, only time.
+    pub memory_budget: usize,
     /// Worker threads (≥ 1). Results do not depend on it.
     pub threads: usize,
     /// Jobs in flight in the solver's pipeline at most (≥ 1): bounds the memory the pipeline
@@ -57,12 +59,19 @@ pub struct Options {
     pub pipeline_capacity: usize,
     /// Seed of every random choice (sample placement, shadow rays).
     pub seed: u64,
-    /// Visibility backend.
-    pub backend: Backend,
 }
 
 /// Initial sample count the automatic ε aims at.
 pub const AUTO_SAMPLES: f64 = 4000.0;
+
+/// The default [`Options::memory_budget`]: 8 GiB, a third of this project's 24 GiB test
+/// machine: half of it holds about 1.4 million samples at [`BYTES_PER_SAMPLE`].
+pub const DEFAULT_MEMORY_BUDGET: usize = 8 << 30;
+
+/// Bytes a sample is budgeted at before it is placed: its arrays, area cells and shares,
+/// index entries and results. `Solution::bytes` / samples measured 1,420–1,950 on the shipped
+/// scenes at the defaults (vectors grown by doubling hold up to twice what they use).
+pub const BYTES_PER_SAMPLE: usize = 3072;
 
 /// The default [`Options::cluster_threshold`].
 pub const DEFAULT_CLUSTER_THRESHOLD: f64 = 0.05;
@@ -80,13 +89,12 @@ impl Default for Options {
             max_samples: 2_000_000,
             cluster_threshold: DEFAULT_CLUSTER_THRESHOLD,
             exact_visibility: false,
-            cache_bytes: 2 << 30,
+            memory_budget: DEFAULT_MEMORY_BUDGET,
             threads: std::thread::available_parallelism()
                 .map_or(2, |n| n.get())
                 .min(8),
             pipeline_capacity: 16,
             seed: 1,
-            backend: Backend::default_backend(),
         }
     }
 }

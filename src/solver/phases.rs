@@ -236,7 +236,9 @@ impl Solve<'_> {
         }
         let probe_seconds = t.elapsed().as_secs_f64();
 
-        // Shoot.
+        // Shoot, with what the samples leave of the memory budget.
+        let solution_bytes = solution.bytes();
+        let memory_left = options.memory_budget.saturating_sub(solution_bytes);
         let t = Instant::now();
         let reflectances: Vec<DVec3> = (0..n)
             .map(|k| reflectance(scene, &solution.samples, k))
@@ -264,7 +266,7 @@ impl Solve<'_> {
                 200 * n as u64
             }),
             lift: self.lift,
-            memory_bytes: options.cache_bytes,
+            memory_bytes: memory_left,
             normalise: round == 0 || hierarchical,
             threshold: options.cluster_threshold,
             exact_visibility: options.exact_visibility,
@@ -318,6 +320,7 @@ impl Solve<'_> {
             added: added.added,
             refined: added.refined,
             capped: added.capped,
+            solution_bytes: solution_bytes as u64,
             direct_queries,
             areas: area_stats,
             shooting,
@@ -352,7 +355,10 @@ impl Solve<'_> {
                 threads: options.threads.max(1),
                 round: round as u16,
                 seed: options.seed,
-                max_samples: options.max_samples,
+                // Half the budget for the samples, the rest for links and caches.
+                max_samples: options
+                    .max_samples
+                    .min(options.memory_budget / 2 / super::BYTES_PER_SAMPLE),
             },
             &mut reporter(
                 &mut *self.progress,

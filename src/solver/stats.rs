@@ -100,8 +100,11 @@ pub struct RoundStats {
     pub added: usize,
     /// Samples whose error exceeded ζ (rounds ≥ 1).
     pub refined: usize,
-    /// Whether `max_samples` stopped the addition.
+    /// Whether `max_samples` (or half the memory budget) stopped the addition.
     pub capped: bool,
+    /// Bytes the solution held while shooting (samples, index, results); the links and
+    /// caches are in [`ShootStats::bytes`].
+    pub solution_bytes: u64,
     /// Shadow-ray queries for direct light.
     pub direct_queries: u64,
     /// Area cells used.

@@ -1,7 +1,6 @@
 //! Visibility: the one trait the solver and renderer ask, answered a batch at a time by Embree
 //! (through our C shim in `ffi/`) or by the pure-Rust `obvhs` BVH.
 
-pub mod bench;
 mod bvh;
 #[cfg(feature = "embree")]
 mod embree;
@@ -180,4 +179,32 @@ pub(crate) fn check_lengths(backend: &'static str, queries: usize, out: usize) -
             problem: format!("{queries} queries but {out} output slots"),
         })
     }
+}
+
+/// Occlusion of many segments on up to `threads` threads (batches of 4,096), for tests and
+/// tools.
+pub fn occluded_all(
+    vis: &dyn Visibility,
+    segments: &[Segment],
+    threads: usize,
+) -> Result<Vec<bool>> {
+    let mut out = vec![false; segments.len()];
+    crate::parallel::for_chunks(&mut out, 4096, threads, |first, o| {
+        vis.occluded(&segments[first..first + o.len()], o)
+    })?;
+    Ok(out)
+}
+
+/// Closest hits of many rays on up to `threads` threads (batches of 4,096), for tests and
+/// tools.
+pub fn intersect_all(
+    vis: &dyn Visibility,
+    rays: &[Ray],
+    threads: usize,
+) -> Result<Vec<Option<Hit>>> {
+    let mut out = vec![None; rays.len()];
+    crate::parallel::for_chunks(&mut out, 4096, threads, |first, o| {
+        vis.intersect(&rays[first..first + o.len()], o)
+    })?;
+    Ok(out)
 }

@@ -3,6 +3,8 @@
 
 #![allow(dead_code)]
 
+pub mod counting;
+
 use std::path::PathBuf;
 
 use glam::Vec3;
@@ -155,7 +157,6 @@ pub fn solve_and_render(
     render: bool,
 ) -> (meshlight::Solution, meshlight::Image) {
     let vis = backend.build(scene).unwrap();
-    let options = meshlight::Options { backend, ..options };
     let solution = meshlight::solve(scene, vis.as_ref(), &options, &mut |_| {
         meshlight::solver::Control::Continue
     })

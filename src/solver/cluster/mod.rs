@@ -146,10 +146,27 @@ pub(crate) fn shoot(
         .collect();
     let link = |(x, y): (usize, usize)| linker.links_between(roots[x], roots[y]);
     let total = pairs.len();
+    // The links count against what the samples leave of the memory budget, as they come in:
+    // the pipeline holds at most its capacity of jobs' links beyond them.
+    let mut held = 0usize;
     let flow = with_pool(threads, settings.capacity, &link, |pool| {
         pool.run(pairs.iter().copied(), |job, (first, second)| {
             let (x, y) = pairs[job];
             stats.queries += first.queries + second.queries;
+            held += first.bytes() + second.bytes();
+            if held > settings.memory_bytes {
+                return Err(crate::Error::Option {
+                    option: "memory_budget",
+                    problem: format!(
+                        "the cluster links outgrew what the samples leave of the memory budget \
+                         ({} after {} of {} groups' pairs; raise --memory-budget or \
+                         --cluster-threshold)",
+                        super::human_bytes(settings.memory_bytes as f64),
+                        job + 1,
+                        total
+                    ),
+                });
+            }
             for (group, links) in [(x, first), (y, second)] {
                 if !(links.leaf.is_empty() && links.cluster.is_empty()) {
                     groups[group].links.push(links);

@@ -5,10 +5,9 @@
 
 use std::time::{Duration, Instant};
 
-use super::workload::{camera_rays, facing_segments};
-use super::{Backend, BvhPreset, BvhScene, Hit, Ray, Segment, Visibility};
-use crate::error::Result;
-use crate::scene::Scene;
+use meshlight::visibility::workload::{camera_rays, facing_segments};
+use meshlight::visibility::{Backend, BvhPreset, BvhScene, Hit, Visibility};
+use meshlight::{Result, Scene};
 
 /// What to measure.
 #[derive(Clone, Debug)]
@@ -180,8 +179,8 @@ pub fn run(
 
     #[cfg(feature = "embree")]
     if options.backends.contains(&Backend::Embree) {
-        use super::{EmbreeMode, EmbreeOptions, EmbreeScene};
-        report.embree_headers = Some(super::embree_headers());
+        use meshlight::visibility::{embree_headers, EmbreeMode, EmbreeOptions, EmbreeScene};
+        report.embree_headers = Some(embree_headers());
         let embree = EmbreeScene::new(scene, EmbreeOptions::default())?;
         let mut occluded = vec![false; segments.len()];
         let mut hits = vec![None; rays.len()];
@@ -265,14 +264,17 @@ fn build(
         )),
         #[cfg(feature = "embree")]
         (Backend::Embree, _) => {
-            let options = super::EmbreeOptions::default();
+            let options = meshlight::visibility::EmbreeOptions::default();
             let detail = format!(
                 "embree {} {}{}",
                 meshlight_embree_sys::MAJOR,
                 options.occlusion_mode.name(),
                 if options.robust { " robust" } else { "" }
             );
-            Ok((Box::new(super::EmbreeScene::new(scene, options)?), detail))
+            Ok((
+                Box::new(meshlight::visibility::EmbreeScene::new(scene, options)?),
+                detail,
+            ))
         }
         _ => Ok((backend.build(scene)?, backend.name().to_string())),
     }
@@ -322,26 +324,4 @@ pub fn parallel<Q: Sync, O: Send>(
             .into_iter()
             .try_for_each(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
     })
-}
-
-/// Convenience for tests and tools: occlusion of many segments on all threads given.
-pub fn occluded_all(
-    vis: &dyn Visibility,
-    segments: &[Segment],
-    threads: usize,
-) -> Result<Vec<bool>> {
-    let mut out = vec![false; segments.len()];
-    parallel(segments, &mut out, threads, 4096, |s, o| vis.occluded(s, o))?;
-    Ok(out)
-}
-
-/// Convenience for tests and tools: closest hits of many rays on all threads given.
-pub fn intersect_all(
-    vis: &dyn Visibility,
-    rays: &[Ray],
-    threads: usize,
-) -> Result<Vec<Option<Hit>>> {
-    let mut out = vec![None; rays.len()];
-    parallel(rays, &mut out, threads, 4096, |r, o| vis.intersect(r, o))?;
-    Ok(out)
 }

@@ -1,0 +1,97 @@
+//! The memory budget: a solve that would not fit is refused before it allocates, naming the
+//! predicted size; links that outgrow what is left end the solve with an error; within the
+//! budget results do not depend on it.
+
+mod common;
+
+use common::counting::{self, Counting};
+use common::shipped;
+use meshlight::solver::{Control, Options, BYTES_PER_SAMPLE};
+use meshlight::{Backend, Error, Scene};
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+fn solve(scene: &Scene, options: &Options) -> meshlight::Result<meshlight::Solution> {
+    let vis = Backend::Bvh.build(scene).unwrap();
+    meshlight::solve(scene, vis.as_ref(), options, &mut |_| Control::Continue)
+}
+
+#[test]
+fn a_budget_too_small_is_refused_before_allocating_and_names_the_predicted_size() {
+    let room = Scene::load(shipped("room")).unwrap();
+    let budget = 4 << 20;
+    let options = Options {
+        memory_budget: budget,
+        rounds: 0,
+        ..Options::default()
+    };
+    let vis = Backend::Bvh.build(&room).unwrap();
+    counting::reset_peak();
+    let before = counting::live();
+    let e =
+        meshlight::solve(&room, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap_err();
+    // Refused before the samples existed: the call held far less than the budget at its peak.
+    let held = counting::peak() - before;
+    assert!(
+        held < (budget / 8) as i64,
+        "held {held} bytes before refusing"
+    );
+    let Error::Option { option, problem } = &e else {
+        panic!("{e}")
+    };
+    assert_eq!(*option, "memory_budget");
+    // The prediction named: about 0.7 × area / ε² samples (ε 0.25, `room`: 296.6 m² of
+    // reflecting area, 16 reflecting sides) at BYTES_PER_SAMPLE each.
+    let area =
+        4.0 * 5.5 * 9.0 + 2.0 * 5.5 * 5.5 + 5.0 * 1.65 * 1.65 + 4.0 * 1.65 * 3.3 + 1.65 * 1.65;
+    let samples = 0.7 * area / (0.25f64 * 0.25) + 16.0;
+    let mib = samples * BYTES_PER_SAMPLE as f64 / (1024.0 * 1024.0);
+    assert!(
+        problem.contains(&format!("about {samples:.0} samples")),
+        "{problem}"
+    );
+    assert!(problem.contains(&format!("{mib:.1} MiB")), "{problem}");
+
+    // The prediction holds the solve it refused: with room enough, round 0 takes less.
+    let fits = Options {
+        memory_budget: 1 << 30,
+        rounds: 0,
+        ..Options::default()
+    };
+    let s = solve(&room, &fits).unwrap();
+    let actual = s.rounds[0].solution_bytes as f64;
+    assert!(
+        actual <= samples * BYTES_PER_SAMPLE as f64,
+        "{actual} bytes held"
+    );
+    assert!(
+        actual >= samples * BYTES_PER_SAMPLE as f64 / 4.0,
+        "{actual} bytes held"
+    );
+}
+
+#[test]
+fn links_that_outgrow_the_budget_end_the_solve_with_an_error_and_within_it_nothing_changes() {
+    let room = Scene::load(shipped("room")).unwrap();
+    // A threshold this small links nearly every pair of samples: tens of MB of links.
+    let greedy = Options {
+        cluster_threshold: 1e-7,
+        rounds: 0,
+        memory_budget: 32 << 20,
+        ..Options::default()
+    };
+    let e = solve(&room, &greedy).unwrap_err();
+    assert!(e.to_string().contains("cluster links outgrew"), "{e}");
+
+    // The defaults at 64 MiB and at 8 GiB give the same radiosity, bit for bit.
+    let small = Options {
+        memory_budget: 64 << 20,
+        ..Options::default()
+    };
+    let (a, b) = (
+        solve(&room, &small).unwrap(),
+        solve(&room, &Options::default()).unwrap(),
+    );
+    assert_eq!(a.radiosity, b.radiosity);
+}
