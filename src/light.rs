@@ -133,7 +133,7 @@ impl DirectLight {
         Ok((out, queries.into_inner()))
     }
 
-    /// One batch: all shadow rays of its receivers in one visibility call.
+    /// One batch: the shadow rays of its receivers, one visibility call per kind of light.
     fn batch(
         &self,
         vis: &dyn Visibility,
@@ -142,24 +142,45 @@ impl DirectLight {
         seed: u64,
         out: &mut [Arrival],
     ) -> Result<u64> {
-        // Per shadow ray: receiver, unshadowed contribution (per channel via a colour), and a
-        // weight for the ratio estimator.
-        struct Ray {
-            receiver: usize,
-            emitter: usize,
-            contribution: DVec3,
-            weight: f64,
-        }
-        let mut segments = Vec::new();
-        let mut rays = Vec::new();
-        // Per receiver and emitter: analytic irradiance, Σ weights, Σ visible weights.
-        let ne = self.emitters.len();
-        let mut analytic = vec![DVec3::ZERO; points.len() * ne];
-        // Per receiver and emitter: the unoccluded form factor, for emitters that do not reflect.
-        let mut factor = vec![0.0f64; points.len() * ne];
-        let mut weights = vec![[0.0f64; 2]; points.len() * ne];
+        // Per receiver: the light that arrives, and what would arrive with nothing in the way.
+        let mut arrived = vec![DVec3::ZERO; points.len()];
         let mut unoccluded = vec![0.0f64; points.len()];
-        for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
+        let point_queries = self.point_lights_at(vis, points, &mut arrived, &mut unoccluded)?;
+        let mut dark_emitters = vec![0.0f64; points.len()];
+        let area_queries = self.area_lights_at(
+            vis,
+            (points, ids, seed),
+            &mut arrived,
+            &mut unoccluded,
+            &mut dark_emitters,
+        )?;
+        for (r, o) in out.iter_mut().enumerate() {
+            let (h, full) = (arrived[r], unoccluded[r]);
+            *o = Arrival {
+                irradiance: h,
+                visible: if full > 0.0 {
+                    (h.element_sum() / full).clamp(0.0, 1.0) as f32
+                } else {
+                    0.0
+                },
+                dark_emitters: dark_emitters[r],
+            };
+        }
+        Ok(point_queries + area_queries)
+    }
+
+    /// Point lights: I·cosθ/r² through one shadow ray each. Adds to `arrived` and
+    /// `unoccluded`; returns the queries.
+    fn point_lights_at(
+        &self,
+        vis: &dyn Visibility,
+        points: &[(Vec3, Vec3)],
+        arrived: &mut [DVec3],
+        unoccluded: &mut [f64],
+    ) -> Result<u64> {
+        let mut segments = Vec::new();
+        let mut lit = Vec::new();
+        for (r, &(x, n)) in points.iter().enumerate() {
             let from = x + self.lift * n;
             for &(p, intensity) in &self.points {
                 let d = p - x;
@@ -169,17 +190,45 @@ impl DirectLight {
                     let contribution = intensity * f64::from(cos / r2);
                     unoccluded[r] += contribution.element_sum();
                     segments.push(Segment { a: from, b: p });
-                    rays.push(Ray {
-                        receiver: r,
-                        emitter: usize::MAX,
-                        contribution,
-                        weight: 0.0,
-                    });
+                    lit.push((r, contribution));
                 }
             }
-            if ne == 0 {
-                continue;
+        }
+        let mut blocked = vec![false; segments.len()];
+        vis.occluded(&segments, &mut blocked)?;
+        for (&(r, contribution), &blocked) in lit.iter().zip(&blocked) {
+            if !blocked {
+                arrived[r] += contribution;
             }
+        }
+        Ok(segments.len() as u64)
+    }
+
+    /// Area lights: Lambert's exact irradiance × the visible share of stratified shadow rays
+    /// (the ratio estimator). Adds to `arrived`, `unoccluded` and `dark_emitters` (the visible
+    /// form factor to emitters that do not reflect); returns the queries.
+    fn area_lights_at(
+        &self,
+        vis: &dyn Visibility,
+        (points, ids, seed): (&[(Vec3, Vec3)], &[u32], u64),
+        arrived: &mut [DVec3],
+        unoccluded: &mut [f64],
+        dark_emitters: &mut [f64],
+    ) -> Result<u64> {
+        let ne = self.emitters.len();
+        if ne == 0 {
+            return Ok(0);
+        }
+        // Per receiver and emitter: analytic irradiance, the unoccluded form factor (emitters
+        // that do not reflect), and [Σ weights, Σ visible weights] of its shadow rays.
+        let mut analytic = vec![DVec3::ZERO; points.len() * ne];
+        let mut factor = vec![0.0f64; points.len() * ne];
+        let mut weights = vec![[0.0f64; 2]; points.len() * ne];
+        let mut segments = Vec::new();
+        // Per shadow ray: (receiver × emitter slot, weight).
+        let mut rays: Vec<(usize, f64)> = Vec::new();
+        for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
+            let from = x + self.lift * n;
             let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 2));
             for (e, emitter) in self.emitters.iter().enumerate() {
                 // Emitters light only what lies in front of them.
@@ -194,9 +243,10 @@ impl DirectLight {
                 if irradiance <= 0.0 {
                     continue;
                 }
-                analytic[r * ne + e] = emitter.ke * irradiance;
+                let slot = r * ne + e;
+                analytic[slot] = emitter.ke * irradiance;
                 if !emitter.reflects {
-                    factor[r * ne + e] = irradiance / std::f64::consts::PI;
+                    factor[slot] = irradiance / std::f64::consts::PI;
                 }
                 unoccluded[r] += (emitter.ke * irradiance).element_sum();
                 let total = *emitter.cumulative.last().unwrap_or(&0.0);
@@ -219,53 +269,30 @@ impl DirectLight {
                         continue;
                     }
                     let weight = f64::from(cos_x * cos_y / (dist2 * dist2));
-                    weights[r * ne + e][0] += weight;
+                    weights[slot][0] += weight;
                     segments.push(Segment {
                         a: from,
                         b: y + self.lift * emitter.normal,
                     });
-                    rays.push(Ray {
-                        receiver: r,
-                        emitter: e,
-                        contribution: DVec3::ZERO,
-                        weight,
-                    });
+                    rays.push((slot, weight));
                 }
             }
         }
         let mut blocked = vec![false; segments.len()];
         vis.occluded(&segments, &mut blocked)?;
-        let mut arrived = vec![DVec3::ZERO; points.len()];
-        for (ray, &blocked) in rays.iter().zip(&blocked) {
-            if blocked {
-                continue;
-            }
-            if ray.emitter == usize::MAX {
-                arrived[ray.receiver] += ray.contribution;
-            } else {
-                weights[ray.receiver * ne + ray.emitter][1] += ray.weight;
+        for (&(slot, weight), &blocked) in rays.iter().zip(&blocked) {
+            if !blocked {
+                weights[slot][1] += weight;
             }
         }
-        for (r, o) in out.iter_mut().enumerate() {
-            let mut h = arrived[r];
-            let mut dark_emitters = 0.0;
+        for r in 0..points.len() {
             for e in 0..ne {
                 let [all, visible] = weights[r * ne + e];
                 if all > 0.0 {
-                    h += analytic[r * ne + e] * (visible / all);
-                    dark_emitters += factor[r * ne + e] * (visible / all);
+                    arrived[r] += analytic[r * ne + e] * (visible / all);
+                    dark_emitters[r] += factor[r * ne + e] * (visible / all);
                 }
             }
-            let full = unoccluded[r];
-            *o = Arrival {
-                irradiance: h,
-                visible: if full > 0.0 {
-                    (h.element_sum() / full).clamp(0.0, 1.0) as f32
-                } else {
-                    0.0
-                },
-                dark_emitters,
-            };
         }
         Ok(segments.len() as u64)
     }

@@ -68,7 +68,7 @@ fn furnace_holds_with_the_hierarchy_and_without_it() {
             // solver (measured 0.997..1.013). The hierarchy's receiver field is first order,
             // and a tangent overestimates a concave field: at face centres, where irradiance
             // peaks, rows reach 1.021 (median 1.008), hence 2.5% for it.
-            let closed: Vec<usize> = (0..s.samples.len()).filter(|&k| s.closed[k]).collect();
+            let closed: Vec<usize> = (0..s.samples.len()).filter(|&k| s.closed()[k]).collect();
             assert!(
                 closed.len() > s.samples.len() * 9 / 10,
                 "{} closed",
@@ -76,7 +76,7 @@ fn furnace_holds_with_the_hierarchy_and_without_it() {
             );
             let (lo, hi) = closed
                 .iter()
-                .map(|&k| 1.0 / f64::from(s.row_scale[k]))
+                .map(|&k| 1.0 / f64::from(s.row_scales()[k]))
                 .fold((f64::MAX, 0.0f64), |(lo, hi), r| (lo.min(r), hi.max(r)));
             let allowed = if threshold == 0.0 { 0.02 } else { 0.025 };
             assert!(

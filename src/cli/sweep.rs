@@ -51,7 +51,7 @@ pub struct Sweep {
     /// ε from the command line, for every run that does not vary it.
     pub epsilon: Option<f32>,
     /// The fixed knobs from the command line.
-    pub knobs: crate::Knobs,
+    pub knobs: super::Knobs,
     /// Rays per side on edge pixels (meshless) or per pixel (patches).
     pub supersample: u32,
     /// Patch side (patches; default the solver's ε).

@@ -59,21 +59,39 @@ pub struct Solution {
     pub rounds: Vec<RoundStats>,
     /// Energy bookkeeping.
     pub ledger: EnergyLedger,
+    // What the solver and renderer need beyond the results: kept with them, not shown.
     /// The surfaces in 2D (for interpolation).
-    pub maps: Vec<SurfaceMap>,
+    pub(crate) maps: Vec<SurfaceMap>,
     /// Range queries over the samples.
-    pub index: SideIndex,
+    pub(crate) index: SideIndex,
     /// Which sides other geometry stands on.
-    pub obstruction: Obstruction,
+    pub(crate) obstruction: Obstruction,
     /// Per sample: whether all its probe rays hit the scene (a closed hemisphere).
-    pub closed: Vec<bool>,
+    pub(crate) closed: Vec<bool>,
     /// Per sample: whether something hovers over it (see `sampling::cover`).
-    pub covered: Vec<bool>,
+    pub(crate) covered: Vec<bool>,
     /// Per sample: the factor its received form factors are scaled by (row normalisation).
-    pub row_scale: Vec<f32>,
+    pub(crate) row_scale: Vec<f32>,
 }
 
 impl Solution {
+    /// Per sample: whether all its probe rays met the scene (a closed hemisphere), where its
+    /// form factors are normalised (diagnostics).
+    pub fn closed(&self) -> &[bool] {
+        &self.closed
+    }
+
+    /// Per sample: the factor its received form factors were scaled by, 1 / the raw row sum
+    /// where the hemisphere is closed (diagnostics: the raw sums are what the furnace checks).
+    pub fn row_scales(&self) -> &[f32] {
+        &self.row_scale
+    }
+
+    /// The surfaces in 2D the samples live in, one per scene surface.
+    pub fn surface_maps(&self) -> &[SurfaceMap] {
+        &self.maps
+    }
+
     /// Bytes the solution holds: samples, their index, and per-sample results (the part of
     /// the memory budget that grows with the samples).
     pub fn bytes(&self) -> usize {

@@ -1,0 +1,345 @@
+//! The command line's arguments and how they resolve into library options: clap's
+//! definitions, sizes, presets and knobs. Reports are in `report.rs`.
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+use meshlight::visibility::BvhPreset;
+use meshlight::{Backend, Options, Scene};
+
+/// Meshless diffuse inter-reflection for rooms, galleries and other interiors.
+#[derive(Parser)]
+#[command(name = "meshlight", version, about)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: Command,
+    /// Refuse a reflectance (Kd) channel of exactly 1 instead of lowering it.
+    #[arg(long, global = true)]
+    pub strict: bool,
+    /// What a reflectance channel of exactly 1 is lowered to (default: the scene file's
+    /// [solver] max_reflectance, else 0.9).
+    #[arg(long, global = true)]
+    pub max_reflectance: Option<f32>,
+}
+
+/// How scenes are read, from the command line (set once, before any scene is loaded).
+pub static LOADING: std::sync::OnceLock<meshlight::scene::LoadOptions> = std::sync::OnceLock::new();
+
+/// Solver settings shared by `render` and `samples`.
+#[derive(clap::Args)]
+pub struct SolveArgs {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// Poisson-disk spacing ε of the initial samples (default: the scene file's, else automatic).
+    #[arg(long)]
+    pub epsilon: Option<f32>,
+    #[command(flatten)]
+    pub knobs: Knobs,
+}
+
+/// Every solver setting but the scene and ε.
+#[derive(clap::Args, Clone)]
+pub struct Knobs {
+    /// Start from a preset: preview, default or final.
+    #[arg(long, default_value = "default")]
+    pub preset: String,
+    /// Adaptive error threshold ζ, relative to the mean radiosity.
+    #[arg(long)]
+    pub zeta: Option<f32>,
+    /// Area weight fall-off α (eq. 5).
+    #[arg(long)]
+    pub alpha: Option<f32>,
+    /// Adaptive rounds after the first solve.
+    #[arg(long)]
+    pub rounds: Option<u32>,
+    /// Shadow rays per area light and sample.
+    #[arg(long)]
+    pub light_samples: Option<u32>,
+    /// Stop shooting when unshot power < this fraction of emitted power.
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// At most this many shots per solve.
+    #[arg(long)]
+    pub max_shots: Option<u64>,
+    /// Refuse to place more samples than this.
+    #[arg(long)]
+    pub max_samples: Option<usize>,
+    /// The memory budget every large structure counts against: bytes, or with a K, M or G
+    /// suffix (binary units), e.g. 512M, 8G (default 8G).
+    #[arg(long, value_parser = parse_bytes)]
+    pub memory_budget: Option<usize>,
+    /// Cluster hierarchy error threshold, relative to the mean radiosity (0: the flat solver).
+    #[arg(long)]
+    pub cluster_threshold: Option<f64>,
+    /// Refine every partly visible cluster link down to samples, however faint (slower).
+    #[arg(long)]
+    pub exact_visibility: bool,
+    /// Visibility backend: embree or bvh.
+    #[arg(long)]
+    pub backend: Option<Backend>,
+    /// Worker threads.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Seed of all random choices.
+    #[arg(long)]
+    pub seed: Option<u64>,
+}
+
+/// How `render` computes its image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// The meshless solver, then interpolation at camera-ray hits.
+    Meshless,
+    /// Unbiased Monte Carlo path tracing: the reference.
+    Pathtrace,
+    /// The paper's baseline: progressive radiosity on a regular mesh of square patches.
+    Patches,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Solve a scene and render its camera view: linear OpenEXR plus a tone-mapped PNG beside it.
+    Render {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// Output image (.exr); the PNG gets the same name with .png.
+        #[arg(short, long, default_value = "out.exr")]
+        output: PathBuf,
+        /// Rays per side on pixels that straddle an edge (1 = one ray per pixel).
+        #[arg(long, default_value_t = 4)]
+        supersample: u32,
+        /// How to compute the image: meshless (the solver), or pathtrace (the independent
+        /// reference: unbiased Monte Carlo path tracing).
+        #[arg(long, default_value = "meshless")]
+        method: Method,
+        /// Path tracing: samples per pixel.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Path tracing: stop after this many seconds (with fewer samples per pixel).
+        #[arg(long)]
+        time: Option<f64>,
+        /// Patches: the side of the square patches (default: the solver's ε).
+        #[arg(long)]
+        patch_size: Option<f32>,
+    },
+    /// Compare an image with a reference: mean absolute error / mean (the paper's measure) and more.
+    Compare {
+        /// The image to judge (.exr).
+        image: PathBuf,
+        /// The reference (.exr).
+        reference: PathBuf,
+        /// Also write a false-colour picture of the signed error per pixel (PNG, with a legend):
+        /// red where the image is too bright, blue where too dark.
+        #[arg(long)]
+        diff: Option<PathBuf>,
+        /// The error at which the picture's colours saturate, as a fraction of the reference's
+        /// mean (default: the 99th percentile of |error|, rounded up to 1, 2 or 5).
+        #[arg(long)]
+        diff_range: Option<f64>,
+        /// Compare averages over blocks of N × N pixels: a noisy reference's noise falls by
+        /// about N, errors spanning several pixels stay.
+        #[arg(long, default_value_t = 1)]
+        block: u32,
+    },
+    /// Run a grid of settings against a reference image: a CSV of time and error per run, and
+    /// a plot of error against time with the Pareto front and the path tracer's curve.
+    Sweep {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// The reference image (.exr), e.g. from `render --method pathtrace` with many samples;
+        /// every run renders at its size.
+        #[arg(long)]
+        reference: PathBuf,
+        /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
+        /// Keys: preset, epsilon, zeta, alpha, rounds, light-samples, tolerance, max-shots,
+        /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
+        /// supersample, patch-size, spp.
+        #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
+        vary: Vec<(String, Vec<String>)>,
+        /// How each run computes its image.
+        #[arg(long, default_value = "meshless")]
+        method: Method,
+        /// Rays per side on edge pixels (meshless) or per pixel (patches).
+        #[arg(long, default_value_t = 4)]
+        supersample: u32,
+        /// Patches: the side of the square patches (default: the solver's ε).
+        #[arg(long)]
+        patch_size: Option<f32>,
+        /// Path tracing runs: samples per pixel.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Output prefix: writes PREFIX.csv and PREFIX.png.
+        #[arg(long, default_value = "sweep")]
+        out: PathBuf,
+        /// Leave out the path tracer's curve.
+        #[arg(long)]
+        no_pathtrace: bool,
+        /// Measure errors on averages over blocks of N × N pixels (see `compare --block`).
+        #[arg(long, default_value_t = 1)]
+        block: u32,
+        /// The path tracer's curve doubles samples per pixel from 2 up to this many, or until a
+        /// render takes longer than --pathtrace-seconds.
+        #[arg(long, default_value_t = 4096)]
+        max_spp: u32,
+        /// The path tracer's curve stops after a render longer than this (default: twice the
+        /// slowest run). Its seed differs from --seed, so it never repeats the samples of a
+        /// reference traced with --seed.
+        #[arg(long)]
+        pathtrace_seconds: Option<f64>,
+    },
+    /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
+    Samples {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// Output point cloud (.ply).
+        #[arg(short, long, default_value = "samples.ply")]
+        output: PathBuf,
+    },
+    /// Measure how the solver scales: solve at several ε with the cluster hierarchy and (where
+    /// it fits in the time limit) the flat solver, print samples, links, queries, seconds per
+    /// phase and peak memory, and the exponents of time and queries against the samples.
+    Scale {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// The spacings to solve at, comma-separated, largest first (e.g. 0.6,0.3,0.15).
+        #[arg(long, value_delimiter = ',', required = true)]
+        epsilon: Vec<f32>,
+        /// Skip a flat solve predicted (from the previous one, as N²) to take longer than this
+        /// many seconds.
+        #[arg(long, default_value_t = 600.0)]
+        flat_limit: f64,
+        #[command(flatten)]
+        knobs: Knobs,
+    },
+    /// Print a summary of a scene: geometry, surfaces, lights, camera.
+    Info {
+        /// The scene file (TOML).
+        scene: PathBuf,
+    },
+    /// Measure the visibility backends on a scene (occlusion and closest-hit rates).
+    BenchVis {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// Occlusion queries: segments between random points of facing surfaces.
+        #[arg(long, default_value_t = 1_000_000)]
+        queries: usize,
+        /// Closest-hit queries: camera rays.
+        #[arg(long, default_value_t = 100_000)]
+        rays: usize,
+        /// Thread counts to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [1, 2])]
+        threads: Vec<usize>,
+        /// Backends to measure, comma-separated (embree, bvh); default: all in this build.
+        #[arg(long, value_delimiter = ',')]
+        backend: Vec<Backend>,
+        /// obvhs presets to measure for `bvh`: fast, medium, very-slow, thorough, thorough-wide,
+        /// or all.
+        #[arg(long, value_delimiter = ',', default_value = "thorough-wide")]
+        bvh_preset: Vec<String>,
+        /// Queries per call through the backend trait.
+        #[arg(long, default_value_t = 1024)]
+        batch: usize,
+        /// Each figure is the best of this many runs.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Seed of the random queries.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+}
+
+/// Parses `--bvh-preset` names.
+pub fn bvh_presets(names: &[String]) -> anyhow::Result<Vec<BvhPreset>> {
+    let mut presets = Vec::new();
+    for name in names {
+        match (name.as_str(), BvhPreset::from_name(name)) {
+            ("all", _) => presets.extend(BvhPreset::ALL),
+            (_, Some(preset)) => presets.push(preset),
+            (other, None) => {
+                let known: Vec<&str> = BvhPreset::ALL.iter().map(|p| p.name()).collect();
+                anyhow::bail!(
+                    "unknown --bvh-preset '{other}' (known: {}, all)",
+                    known.join(", ")
+                )
+            }
+        }
+    }
+    Ok(presets)
+}
+
+/// The scene, and options from a preset, the scene file and the command line, in that order
+/// of precedence.
+pub fn solve_setup(
+    scene: &std::path::Path,
+    epsilon: Option<f32>,
+    args: &Knobs,
+) -> anyhow::Result<(Scene, Options)> {
+    let scene = crate::load(scene)?;
+    Ok((scene, options_from(epsilon, args)?))
+}
+
+/// A size in bytes: a number with an optional K, M or G suffix (binary units).
+pub fn parse_bytes(text: &str) -> Result<usize, String> {
+    let t = text.trim();
+    let (number, unit) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => (&t[..i], c.to_ascii_uppercase()),
+        _ => (t, 'B'),
+    };
+    let scale: f64 = match unit {
+        'B' => 1.0,
+        'K' => 1024.0,
+        'M' => 1024.0 * 1024.0,
+        'G' => 1024.0 * 1024.0 * 1024.0,
+        _ => return Err(format!("'{text}': the unit must be K, M or G")),
+    };
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a size (e.g. 512M, 8G)"))?;
+    let bytes = value * scale;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < usize::MAX as f64) {
+        return Err(format!("'{text}' is not a positive size"));
+    }
+    Ok(bytes as usize)
+}
+
+/// The visibility backend the command line asks for (default: Embree if built in).
+pub fn backend_from(args: &Knobs) -> meshlight::Backend {
+    args.backend
+        .unwrap_or_else(meshlight::Backend::default_backend)
+}
+
+/// Options from a preset and the command line's knobs.
+pub fn options_from(epsilon: Option<f32>, args: &Knobs) -> anyhow::Result<Options> {
+    let mut o = args.preset.parse::<meshlight::solver::Preset>()?.options();
+    o.epsilon = epsilon.or(o.epsilon);
+    o.zeta = args.zeta.unwrap_or(o.zeta);
+    o.alpha = args.alpha.unwrap_or(o.alpha);
+    o.rounds = args.rounds.unwrap_or(o.rounds);
+    o.light_samples = args.light_samples.unwrap_or(o.light_samples);
+    o.tolerance = args.tolerance.unwrap_or(o.tolerance);
+    o.max_shots = args.max_shots.or(o.max_shots);
+    o.max_samples = args.max_samples.unwrap_or(o.max_samples);
+    o.memory_budget = args.memory_budget.unwrap_or(o.memory_budget);
+    o.cluster_threshold = args.cluster_threshold.unwrap_or(o.cluster_threshold);
+    o.exact_visibility |= args.exact_visibility;
+    o.threads = args.threads.unwrap_or(o.threads).max(1);
+    o.seed = args.seed.unwrap_or(o.seed);
+    Ok(o)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_bytes;
+
+    #[test]
+    fn sizes_parse_in_binary_units() {
+        assert_eq!(parse_bytes("1000"), Ok(1000));
+        assert_eq!(parse_bytes("512M"), Ok(512 << 20));
+        assert_eq!(parse_bytes("8g"), Ok(8 << 30));
+        assert_eq!(parse_bytes("1.5K"), Ok(1536));
+        for bad in ["", "G", "-1G", "0", "4X", "lots"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
+    }
+}

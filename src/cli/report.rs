@@ -1,0 +1,358 @@
+//! What the command line prints: scene info, solve and render summaries, the visibility
+//! benchmark's tables.
+
+use std::fmt::Write;
+
+use glam::{DVec3, Vec3};
+use meshlight::render::RenderStats;
+use meshlight::solver::{EpsilonSource, Options, StopReason};
+use meshlight::{Image, Scene, Solution};
+
+use super::bench::{BenchReport, Rate};
+
+fn v3(v: Vec3) -> String {
+    format!("[{}, {}, {}]", v.x, v.y, v.z)
+}
+
+fn rgb(v: DVec3) -> String {
+    format!("{:.4} {:.4} {:.4}", v.x, v.y, v.z)
+}
+
+/// `meshlight info`.
+pub fn info(scene: &Scene) -> String {
+    let mut s = String::new();
+    let b = &scene.bounds;
+    let c = &scene.camera;
+    let _ = writeln!(s, "scene         {}", scene.path.display());
+    let _ = writeln!(s, "triangles     {}", scene.triangles.len());
+    let _ = writeln!(s, "surfaces      {}", scene.surfaces.len());
+    let _ = writeln!(s, "materials     {}", scene.materials.len());
+    let _ = writeln!(s, "total area    {:.6}", scene.total_area());
+    let _ = writeln!(
+        s,
+        "two-sided     {}",
+        if scene.two_sided { "yes" } else { "no" }
+    );
+    let _ = writeln!(
+        s,
+        "bounds        {} to {} (diagonal {:.6})",
+        v3(b.min),
+        v3(b.max),
+        b.diagonal()
+    );
+    let emitters: Vec<_> = scene.emitters().collect();
+    let area: f64 = 0.0
+        + emitters
+            .iter()
+            .map(|&(i, _)| scene.surfaces[i as usize].area)
+            .sum::<f64>();
+    let power: DVec3 = emitters.iter().map(|&(_, p)| p).sum();
+    let _ = writeln!(
+        s,
+        "area lights   {} surface(s), area {:.6}, power {} W",
+        emitters.len(),
+        area,
+        rgb(power)
+    );
+    const LISTED: usize = 10;
+    for &(i, p) in emitters.iter().take(LISTED) {
+        let surface = &scene.surfaces[i as usize];
+        let _ = writeln!(
+            s,
+            "  surface {i} '{}': area {:.6}, normal {}, power {} W",
+            scene.material_of(i).name,
+            surface.area,
+            v3(surface.normal),
+            rgb(p)
+        );
+    }
+    if emitters.len() > LISTED {
+        let _ = writeln!(s, "  ... and {} more", emitters.len() - LISTED);
+    }
+    let _ = writeln!(s, "point lights  {}", scene.point_lights.len());
+    for l in scene.point_lights.iter().take(LISTED) {
+        let _ = writeln!(
+            s,
+            "  at {}: intensity {} W/sr, power {} W",
+            v3(l.position),
+            v3(l.intensity),
+            rgb(l.power())
+        );
+    }
+    if scene.point_lights.len() > LISTED {
+        let _ = writeln!(s, "  ... and {} more", scene.point_lights.len() - LISTED);
+    }
+    let _ = writeln!(s, "emitted power {} W", rgb(scene.emitted_power()));
+    let _ = writeln!(
+        s,
+        "camera        at {} looking at {}, up {}, fov_y {}°, {}x{}",
+        v3(c.position),
+        v3(c.look_at),
+        v3(c.up),
+        c.fov_y,
+        c.width,
+        c.height
+    );
+    match scene.solver.epsilon {
+        Some(e) => {
+            let _ = writeln!(s, "solver        epsilon {e} (scene file)");
+        }
+        None => {
+            let _ = writeln!(s, "solver        no defaults in the scene file");
+        }
+    }
+    s
+}
+
+fn mega(rates: &[Rate], threads: usize) -> Option<f64> {
+    rates
+        .iter()
+        .find(|r| r.threads == threads)
+        .map(|r| r.per_second / 1e6)
+}
+
+fn cells(rates: &[Rate], threads: &[usize]) -> String {
+    threads
+        .iter()
+        .map(|&t| mega(rates, t).map_or_else(|| format!("{:>9}", "-"), |m| format!("{m:>9.2}")))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// `meshlight bench-vis`.
+pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
+    let mut s = String::new();
+    let threads: Vec<usize> = r
+        .backends
+        .first()
+        .map(|b| b.occlusion.iter().map(|x| x.threads).collect())
+        .unwrap_or_default();
+    let _ = writeln!(
+        s,
+        "scene {}: {} triangles; {} occlusion segments (facing surface points), {} camera rays",
+        scene.path.display(),
+        scene.triangles.len(),
+        r.segments,
+        r.rays
+    );
+    if let Some(h) = r.embree_headers {
+        let _ = writeln!(s, "embree shim compiled against {h}");
+    }
+    let heads = |what: &str| {
+        threads
+            .iter()
+            .map(|t| format!("{:>9}", format!("{what} {t}T")))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let _ = writeln!(
+        s,
+        "\nMillion queries per second (best of runs), through the Visibility trait:"
+    );
+    let _ = writeln!(
+        s,
+        "{:<28} {:>10} {} {}",
+        "backend",
+        "build ms",
+        heads("occl"),
+        heads("hit")
+    );
+    for b in &r.backends {
+        let _ = writeln!(
+            s,
+            "{:<28} {:>10.2} {} {}",
+            b.detail,
+            b.build.as_secs_f64() * 1e3,
+            cells(&b.occlusion, &threads),
+            cells(&b.intersect, &threads)
+        );
+    }
+    if !r.embree_raw.is_empty() {
+        let _ = writeln!(s, "\nEmbree raw shim, whole share per call (Mq/s):");
+        let _ = writeln!(
+            s,
+            "{:<28} {:>10} {} {}",
+            "mode",
+            "",
+            heads("occl"),
+            heads("hit")
+        );
+        for raw in &r.embree_raw {
+            let _ = writeln!(
+                s,
+                "{:<28} {:>10} {} {}",
+                raw.mode,
+                "",
+                cells(&raw.occlusion, &threads),
+                cells(&raw.intersect, &threads)
+            );
+        }
+        if let Some(embree) = r
+            .backends
+            .iter()
+            .find(|b| b.backend == meshlight::Backend::Embree)
+        {
+            for &t in &threads {
+                let best = r
+                    .embree_raw
+                    .iter()
+                    .filter_map(|raw| mega(&raw.occlusion, t))
+                    .fold(0.0, f64::max);
+                if let (Some(through), true) = (mega(&embree.occlusion, t), best > 0.0) {
+                    let _ = writeln!(
+                        s,
+                        "trait / best raw path, {t} thread(s): {:.1}%",
+                        100.0 * through / best
+                    );
+                }
+            }
+        }
+    }
+    let embree = r
+        .backends
+        .iter()
+        .find(|b| b.backend == meshlight::Backend::Embree);
+    if let Some(e) = embree {
+        for b in r
+            .backends
+            .iter()
+            .filter(|b| b.backend != meshlight::Backend::Embree)
+        {
+            for &t in &threads {
+                if let (Some(x), Some(y)) = (mega(&e.occlusion, t), mega(&b.occlusion, t)) {
+                    let hx = mega(&e.intersect, t).unwrap_or(0.0);
+                    let hy = mega(&b.intersect, t).unwrap_or(f64::NAN);
+                    let _ = writeln!(
+                        s,
+                        "embree / {}, {t} thread(s): occlusion {:.2}x, closest hit {:.2}x",
+                        b.detail,
+                        x / y,
+                        hx / hy
+                    );
+                }
+            }
+        }
+    }
+    if let Some(a) = r.agreement {
+        let _ = writeln!(
+            s,
+            "\nagreement embree vs bvh: {} of {} occlusion answers differ ({:.2e}); {} of {} rays differ in hit/miss, {} in distance (>1e-4 relative)",
+            a.occlusion,
+            r.segments,
+            a.occlusion as f64 / r.segments.max(1) as f64,
+            a.hit_or_miss,
+            r.rays,
+            a.distance
+        );
+    }
+    s
+}
+
+/// The solve's summary: samples per round, shots, queries, unshot fraction, time per phase.
+pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) -> String {
+    let mut out = String::new();
+    let source = match s.epsilon_source {
+        EpsilonSource::Options => "command line",
+        EpsilonSource::SceneFile => "scene file",
+        EpsilonSource::Automatic => "automatic",
+        _ => "",
+    };
+    let _ = writeln!(
+        out,
+        "scene {}: {} triangles, {} surfaces; backend {}, {} thread(s); ε {} ({source}), α {}, ζ {}, {} light samples",
+        scene.path.display(),
+        scene.triangles.len(),
+        scene.surfaces.len(),
+        backend,
+        o.threads,
+        s.epsilon,
+        o.alpha,
+        o.zeta,
+        o.light_samples
+    );
+    let _ = writeln!(
+        out,
+        "{:>5} {:>8} {:>7} {:>7} {:>8} {:>10} {:>11} {:>9} {:>17} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8}",
+        "round",
+        "samples",
+        "added",
+        "refined",
+        "shots",
+        "links",
+        "vis queries",
+        "shadow q",
+        "unshot start→end",
+        "stop",
+        "place s",
+        "areas s",
+        "direct s",
+        "links s",
+        "shoot s"
+    );
+    for r in &s.rounds {
+        let stop = match r.shooting.stop {
+            StopReason::Converged => "converged",
+            StopReason::ShotLimit => "shot limit",
+            StopReason::Stopped => "stopped",
+            StopReason::NoLight => "no light",
+            StopReason::Diverged => "DIVERGED",
+            _ => "?",
+        };
+        let _ = writeln!(
+            out,
+            "{:>5} {:>8} {:>7} {:>7} {:>8} {:>10} {:>11} {:>9} {:>17} {:>10} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3}{}",
+            r.round,
+            r.samples,
+            r.added,
+            r.refined,
+            r.shooting.shots,
+            r.shooting.links,
+            r.shooting.queries,
+            r.direct_queries,
+            format!("{:.2e}→{:.2e}", r.shooting.initial_unshot_fraction, r.shooting.unshot_fraction),
+            stop,
+            r.seconds.sampling,
+            r.seconds.areas,
+            r.seconds.direct,
+            r.seconds.links,
+            r.seconds.shooting,
+            if r.capped { "  (sample budget reached)" } else { "" }
+        );
+    }
+    if s.stop() == StopReason::Diverged {
+        let _ = writeln!(
+            out,
+            "warning: the solve diverged: its unshot power grew; the image is not to be trusted"
+        );
+    }
+    let bytes: u64 = s.rounds.iter().map(|r| r.shooting.bytes).max().unwrap_or(0);
+    let samples_bytes: u64 = s.rounds.iter().map(|r| r.solution_bytes).max().unwrap_or(0);
+    let _ = writeln!(
+        out,
+        "solver: {}; samples held at most {}, links and caches {}, of a {} budget",
+        if o.cluster_threshold > 0.0 {
+            format!("cluster hierarchy, threshold {}", o.cluster_threshold)
+        } else {
+            "flat (every sample to every sample)".into()
+        },
+        meshlight::solver::human_bytes(samples_bytes as f64),
+        meshlight::solver::human_bytes(bytes as f64),
+        meshlight::solver::human_bytes(o.memory_budget as f64),
+    );
+    if s.stop() == StopReason::ShotLimit {
+        let _ = writeln!(
+            out,
+            "warning: the last solve stopped at its shot limit with {:.2e} of the emitted power unshot",
+            s.rounds.last().map_or(0.0, |r| r.shooting.unshot_fraction)
+        );
+    }
+    out
+}
+
+/// The render's summary.
+pub fn render_summary(image: &Image, stats: &RenderStats, seconds: f64) -> String {
+    format!(
+        "render {}x{}: {} camera rays ({} edge pixels supersampled), {} interpolation queries, {:.3} s; mean radiance {:.5}\n",
+        image.width, image.height, stats.camera_rays, stats.supersampled_pixels, stats.interpolation_queries, seconds, image.mean()
+    )
+}
