@@ -26,6 +26,7 @@
 
 pub mod area;
 pub mod error;
+pub mod ies;
 pub mod light;
 pub mod metrics;
 mod parallel;
