@@ -28,6 +28,8 @@ pub struct Photometry {
     pub candela: Vec<f64>,
     /// Whether the file says absolute photometry (lumens per lamp = −1).
     pub absolute: bool,
+    /// [`Photometry::flux`], integrated once.
+    flux: std::sync::OnceLock<f64>,
 }
 
 /// Numbers after the keyword lines, each with its line.
@@ -242,6 +244,7 @@ impl Photometry {
             horizontal,
             candela,
             absolute: lumens == -1.0,
+            flux: std::sync::OnceLock::new(),
         })
     }
 
@@ -304,8 +307,12 @@ impl Photometry {
     }
 
     /// The luminous flux (lumens): ∫ I dΩ over the sphere, by the midpoint rule on a
-    /// 0.1° × 0.25° grid of the interpolated distribution.
+    /// 0.1° × 0.25° grid of the interpolated distribution (integrated once, then kept).
     pub fn flux(&self) -> f64 {
+        *self.flux.get_or_init(|| self.integrate())
+    }
+
+    fn integrate(&self) -> f64 {
         let (ng, nc) = (1800usize, 1440usize);
         let (dg, dc) = (
             std::f64::consts::PI / ng as f64,

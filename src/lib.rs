@@ -28,6 +28,7 @@ pub mod area;
 pub mod error;
 pub mod ies;
 pub mod light;
+pub mod lux;
 pub mod metrics;
 mod parallel;
 pub mod ply;

@@ -15,7 +15,7 @@ use rand_pcg::Pcg64Mcg;
 use crate::error::Result;
 use crate::parallel::for_chunks_reporting;
 use crate::sampling::poisson::side_seed;
-use crate::scene::Scene;
+use crate::scene::{PointSource, Scene};
 use crate::visibility::{Segment, Visibility};
 
 /// An area light: one emitting surface.
@@ -32,7 +32,7 @@ struct Emitter {
 /// Direct light from a scene's lights.
 pub struct DirectLight {
     emitters: Vec<Emitter>,
-    points: Vec<(Vec3, DVec3)>,
+    points: Vec<PointSource>,
     light_samples: u32,
     lift: f32,
 }
@@ -80,11 +80,7 @@ impl DirectLight {
                 }
             })
             .collect();
-        let points = scene
-            .point_lights
-            .iter()
-            .map(|l| (l.position, l.intensity.as_dvec3()))
-            .collect();
+        let points = scene.point_sources();
         DirectLight {
             emitters,
             points,
@@ -96,7 +92,12 @@ impl DirectLight {
     /// Whether the scene has any light at all.
     pub fn is_dark(&self) -> bool {
         self.emitters.iter().all(|e| e.ke.max_element() <= 0.0)
-            && self.points.iter().all(|(_, i)| i.max_element() <= 0.0)
+            && self.points.iter().all(|s| {
+                s.intensity.max_element() <= 0.0
+                    || s.luminaire
+                        .as_ref()
+                        .is_some_and(|l| l.photometry.flux() <= 0.0)
+            })
     }
 
     /// Shadow rays one receiver may cast (for progress and query counts).
@@ -182,11 +183,13 @@ impl DirectLight {
         let mut lit = Vec::new();
         for (r, &(x, n)) in points.iter().enumerate() {
             let from = x + self.lift * n;
-            for &(p, intensity) in &self.points {
+            for source in &self.points {
+                let p = source.position;
                 let d = p - x;
                 let r2 = d.length_squared();
                 let cos = n.dot(d) / r2.sqrt();
                 if cos > 0.0 && r2 > 0.0 {
+                    let intensity = source.towards(-d).as_dvec3();
                     let contribution = intensity * f64::from(cos / r2);
                     unoccluded[r] += contribution.element_sum();
                     segments.push(Segment { a: from, b: p });

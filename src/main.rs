@@ -211,6 +211,25 @@ fn run(args: Args) -> anyhow::Result<()> {
                 },
             )?;
         }
+        Command::Lux {
+            solve,
+            output,
+            grid_light_samples,
+        } => {
+            let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
+            let vis = cli::backend_from(&solve.knobs).build(&scene)?;
+            let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
+            print!(
+                "{}",
+                cli::solve_summary(&scene, &solution, &options, vis.name())
+            );
+            let lux = meshlight::lux::LuxOptions {
+                light_samples: grid_light_samples.max(1),
+                seed: options.seed,
+                threads: options.threads,
+            };
+            cli::lux::run(&scene, &solution, vis.as_ref(), &lux, &output)?;
+        }
         Command::Samples { solve, output } => {
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
             let vis = cli::backend_from(&solve.knobs).build(&scene)?;

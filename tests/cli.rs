@@ -377,3 +377,53 @@ fn sweep_writes_a_row_per_setting_and_a_plot() {
         text(&bad.stderr)
     );
 }
+
+#[test]
+fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
+    // The furnace box with a 3 × 2 grid floating inside, facing up: E = π · 0.2 everywhere
+    // (radiance 0.2 all round), so Emin ≈ Eavg ≈ Emax and U0 ≈ 1.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    for f in ["box.obj", "box.mtl"] {
+        std::fs::copy(format!("scenes/box/{f}"), dir.path().join(f)).unwrap();
+    }
+    let toml = std::fs::read_to_string("scenes/box/scene.toml").unwrap()
+        + "\n[[grid]]\nname = \"mid plane\"\norigin = [0.2, 0.5, 0.2]\nu = [0.6, 0, 0]\nv = [0, 0, 0.4]\nspacing = 0.2\n";
+    std::fs::write(&scene, toml).unwrap();
+    let out_dir = dir.path().join("lux");
+    let out = meshlight(&[
+        "lux",
+        scene.to_str().unwrap(),
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("grid 'mid plane': 6 points"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let csv = std::fs::read_to_string(out_dir.join("mid_plane.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows[0], "x,y,z,E");
+    assert_eq!(rows.len(), 7);
+    let e: Vec<f64> = rows[1..]
+        .iter()
+        .map(|r| r.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    let want = std::f64::consts::PI * 0.2;
+    for v in &e {
+        assert!((v / want - 1.0).abs() < 0.02, "{v} vs {want}");
+    }
+    let avg = e.iter().sum::<f64>() / 6.0;
+    assert!(
+        line.contains(&format!("Eavg {avg:.4} W/m²")),
+        "{line} (avg {avg:.4})"
+    );
+    assert!(
+        std::fs::metadata(out_dir.join("mid_plane.png"))
+            .unwrap()
+            .len()
+            > 1000
+    );
+}

@@ -187,6 +187,18 @@ pub enum Command {
         #[arg(long)]
         pathtrace_seconds: Option<f64>,
     },
+    /// Solve a scene and measure the illuminance on its grids ([[grid]]): per grid a CSV of
+    /// x,y,z,E, a false-colour plan (PNG) and a line with Emin, Eavg, Emax and the uniformity.
+    Lux {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// Folder for <grid>.csv and <grid>.png.
+        #[arg(short, long, default_value = ".")]
+        output: PathBuf,
+        /// Shadow rays per area light and grid point.
+        #[arg(long, default_value_t = 64)]
+        grid_light_samples: u32,
+    },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
     Samples {
         #[command(flatten)]

@@ -3,6 +3,7 @@
 
 pub mod args;
 pub mod bench;
+pub mod lux;
 pub mod memory;
 pub mod plot;
 pub mod progress;

@@ -183,6 +183,128 @@ pub fn false_colour_png(
     write_rgb(path, w, h, rgb)
 }
 
+/// A sequential colour map for t in [0, 1] (dark blue, blue, green, yellow, red), as lighting
+/// tools colour illuminance.
+pub fn sequential(t: f32) -> [u8; 3] {
+    const STOPS: [[f32; 3]; 5] = [
+        [0.05, 0.05, 0.35],
+        [0.10, 0.35, 0.85],
+        [0.20, 0.75, 0.35],
+        [0.98, 0.85, 0.15],
+        [0.85, 0.10, 0.08],
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } * 4.0;
+    let i = (t.floor() as usize).min(3);
+    let f = t - i as f32;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    [0, 1, 2].map(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0 + 0.5) as u8)
+}
+
+/// Writes a false-colour plan of a grid's values (`nu` × `nv`, row by row along u) from
+/// `low` to `high`, cells scaled to about 480 pixels along the longer side, with iso-lines at
+/// the legend's five values, a colour bar labelled in `unit`, a title and caption lines.
+#[allow(clippy::too_many_arguments)]
+pub fn plan_png(
+    path: &Path,
+    (nu, nv): (u32, u32),
+    values: &[f64],
+    (low, high): (f64, f64),
+    unit: &str,
+    title: &str,
+    caption: &[String],
+) -> Result<()> {
+    font()?;
+    let cell = (480 / nu.max(nv)).clamp(1, 64);
+    let (width, height) = (nu * cell, nv * cell);
+    let legend = 190u32;
+    let (w, h) = (width + legend, height.max(320));
+    let span = if high > low { high - low } else { 1.0 };
+    let level = |v: f64| ((v - low) / span) as f32;
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        // Rows along v drawn from the bottom up, so the plan reads with v upwards.
+        for j in 0..nv {
+            for i in 0..nu {
+                let [r, g, b] = sequential(level(values[(j * nu + i) as usize]));
+                let (x, y) = ((i * cell) as i32, ((nv - 1 - j) * cell) as i32);
+                root.draw(&Rectangle::new(
+                    [(x, y), (x + cell as i32, y + cell as i32)],
+                    RGBColor(r, g, b).filled(),
+                ))
+                .map_err(plot_error)?;
+            }
+        }
+        // Iso-lines: cell edges where the value crosses one of the legend's inner levels.
+        for k in 1..4 {
+            let iso = low + span * f64::from(k) / 4.0;
+            let above = |i: u32, j: u32| values[(j * nu + i) as usize] >= iso;
+            for j in 0..nv {
+                for i in 0..nu {
+                    let (x, y) = ((i * cell) as i32, ((nv - 1 - j) * cell) as i32);
+                    let c = cell as i32;
+                    if i + 1 < nu && above(i, j) != above(i + 1, j) {
+                        root.draw(&PathElement::new(vec![(x + c, y), (x + c, y + c)], BLACK))
+                            .map_err(plot_error)?;
+                    }
+                    if j + 1 < nv && above(i, j) != above(i, j + 1) {
+                        root.draw(&PathElement::new(vec![(x, y), (x + c, y)], BLACK))
+                            .map_err(plot_error)?;
+                    }
+                }
+            }
+        }
+        let style = ("sans-serif", 14).into_font();
+        let left = width as i32 + 14;
+        root.draw(&Text::new(title.to_string(), (left, 8), style.clone()))
+            .map_err(plot_error)?;
+        let (top, bar) = (34i32, 180i32);
+        for i in 0..bar {
+            let [r, g, b] = sequential(1.0 - i as f32 / (bar - 1) as f32);
+            root.draw(&Rectangle::new(
+                [(left, top + i), (left + 22, top + i + 1)],
+                RGBColor(r, g, b).filled(),
+            ))
+            .map_err(plot_error)?;
+        }
+        root.draw(&Rectangle::new(
+            [(left, top), (left + 22, top + bar)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(plot_error)?;
+        for k in 0..5 {
+            let value = high - span * f64::from(k) / 4.0;
+            let y = top + (bar - 1) * k / 4;
+            root.draw(&PathElement::new(
+                vec![(left + 22, y), (left + 27, y)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(plot_error)?;
+            root.draw(&Text::new(
+                format!("{value:.4} {unit}"),
+                (left + 31, y - 7),
+                style.clone(),
+            ))
+            .map_err(plot_error)?;
+        }
+        for (i, line) in caption.iter().enumerate() {
+            root.draw(&Text::new(
+                line.clone(),
+                (left, top + bar + 16 + 18 * i as i32),
+                style.clone(),
+            ))
+            .map_err(plot_error)?;
+        }
+        root.present().map_err(plot_error)?;
+    }
+    write_rgb(path, w, h, rgb)
+}
+
 /// Writes `image`'s signed error against `reference` as a false-colour picture; answers the
 /// range its colours saturate at (`range`, or the 99th percentile of |error| rounded up).
 pub fn write_error_picture(

@@ -69,20 +69,45 @@ pub fn info(scene: &Scene) -> String {
     if emitters.len() > LISTED {
         let _ = writeln!(s, "  ... and {} more", emitters.len() - LISTED);
     }
+    let u = scene.units;
     let _ = writeln!(s, "point lights  {}", scene.point_lights.len());
     for l in scene.point_lights.iter().take(LISTED) {
         let _ = writeln!(
             s,
-            "  at {}: intensity {} W/sr, power {} W",
+            "  at {}: intensity {} {}, power {} {}",
             v3(l.position),
             v3(l.intensity),
-            rgb(l.power())
+            u.intensity(),
+            rgb(l.power()),
+            u.flux()
         );
     }
     if scene.point_lights.len() > LISTED {
         let _ = writeln!(s, "  ... and {} more", scene.point_lights.len() - LISTED);
     }
-    let _ = writeln!(s, "emitted power {} W", rgb(scene.emitted_power()));
+    let _ = writeln!(s, "luminaires    {}", scene.luminaires.len());
+    for l in scene.luminaires.iter().take(LISTED) {
+        let flux = l.flux();
+        let _ = writeln!(
+            s,
+            "  at {}: aim {}, flux {:.1} {} (luminance of {} {})",
+            v3(l.position),
+            v3(l.aim),
+            meshlight::scene::luminance(flux.as_vec3()),
+            u.flux(),
+            rgb(flux),
+            u.flux()
+        );
+    }
+    if scene.luminaires.len() > LISTED {
+        let _ = writeln!(s, "  ... and {} more", scene.luminaires.len() - LISTED);
+    }
+    let _ = writeln!(
+        s,
+        "emitted power {} {}",
+        rgb(scene.emitted_power()),
+        u.flux()
+    );
     let _ = writeln!(
         s,
         "camera        at {} looking at {}, up {}, fov_y {}°, {}x{}",

@@ -201,6 +201,7 @@ fn path_trace_unguarded(
     // Passes of a few samples each: the time limit and progress act between them.
     let pass = 2u32.max(options.spp / 32).min(options.spp);
     let mut done = 0u32;
+    let points = scene.point_sources();
     while done < options.spp {
         let count = pass.min(options.spp - done);
         let first = done;
@@ -208,6 +209,7 @@ fn path_trace_unguarded(
             scene,
             vis,
             lights: &lights,
+            points: &points,
             lift,
             seed: options.seed,
             max_bounces: options.max_bounces,
@@ -261,6 +263,8 @@ struct Tracer<'a> {
     scene: &'a Scene,
     vis: &'a dyn Visibility,
     lights: &'a Lights,
+    /// Point lights and luminaires.
+    points: &'a [crate::scene::PointSource],
     lift: f32,
     seed: u64,
     max_bounces: u32,
@@ -406,7 +410,7 @@ impl Tracer<'_> {
         let reflect = path.throughput * kd / std::f64::consts::PI;
 
         // Next events: every point light, and one point on an emitter.
-        for light in &scene.point_lights {
+        for light in self.points {
             let to = light.position - from;
             let r2 = f64::from(to.length_squared());
             let cos = f64::from(n.dot(to.normalize_or_zero()));
@@ -417,7 +421,7 @@ impl Tracer<'_> {
                 });
                 shadows.push(Shadow {
                     path: index,
-                    contribution: reflect * light.intensity.as_dvec3() * cos / r2,
+                    contribution: reflect * light.towards(-to).as_dvec3() * cos / r2,
                 });
             }
         }

@@ -8,8 +8,9 @@ use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::{validate, Camera, PointLight, SolverDefaults};
+use super::{luminance, validate, Camera, Grid, Luminaire, PointLight, SolverDefaults, Units};
 use crate::error::{Error, Result};
+use crate::ies::Photometry;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -20,6 +21,11 @@ struct SceneToml {
     camera: Spanned<CameraToml>,
     #[serde(default)]
     point_light: Vec<Spanned<PointLightToml>>,
+    #[serde(default)]
+    luminaire: Vec<Spanned<LuminaireToml>>,
+    units: Option<Spanned<String>>,
+    #[serde(default)]
+    grid: Vec<Spanned<GridToml>>,
     #[serde(default)]
     solver: Option<Spanned<SolverToml>>,
 }
@@ -44,6 +50,28 @@ struct PointLightToml {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct LuminaireToml {
+    ies: String,
+    position: [f32; 3],
+    aim: Option<[f32; 3]>,
+    c0: Option<[f32; 3]>,
+    multiplier: Option<f32>,
+    color: Option<[f32; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GridToml {
+    name: String,
+    origin: [f32; 3],
+    u: [f32; 3],
+    v: [f32; 3],
+    normal: Option<[f32; 3]>,
+    spacing: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct SolverToml {
     epsilon: Option<f32>,
     max_reflectance: Option<f32>,
@@ -55,6 +83,9 @@ pub(super) struct SceneFile {
     pub two_sided: bool,
     pub camera: Camera,
     pub point_lights: Vec<PointLight>,
+    pub luminaires: Vec<Luminaire>,
+    pub units: Units,
+    pub grids: Vec<Grid>,
     pub solver: SolverDefaults,
     /// The `obj =` line.
     pub obj_line: usize,
@@ -69,6 +100,108 @@ pub(crate) fn line_of(text: &str, offset: usize) -> usize {
         .filter(|&&b| b == b'\n')
         .count()
         + 1
+}
+
+/// A luminaire from its table: the IES file read (relative to the scene file) and the
+/// orientation checked; problems name the scene file's line, or the IES file's.
+fn luminaire(
+    files: &dyn super::Source,
+    dir: &Path,
+    l: LuminaireToml,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<Luminaire> {
+    let position = Vec3::from(l.position);
+    if let Some(problem) = validate::position(position) {
+        return Err(fail(format!("luminaire position: {problem}")));
+    }
+    let aim = Vec3::from(l.aim.unwrap_or([0.0, -1.0, 0.0]));
+    if !aim.is_finite() || aim.length_squared() < 1e-12 {
+        return Err(fail(format!("luminaire aim {aim} is not a direction")));
+    }
+    let aim = aim.normalize();
+    // The default C = 0 direction: +x, or +z when the aim lies along x.
+    let default_c0 = if aim.x.abs() > 0.9 { Vec3::Z } else { Vec3::X };
+    let c0 = Vec3::from(l.c0.map_or(default_c0.to_array(), |c| c));
+    let c0 = c0 - aim * c0.dot(aim);
+    if !c0.is_finite() || c0.length_squared() < 1e-8 {
+        return Err(fail(format!(
+            "luminaire c0 {c0} is parallel to its aim {aim}"
+        )));
+    }
+    let multiplier = l.multiplier.unwrap_or(1.0);
+    if !(multiplier.is_finite() && multiplier >= 0.0) {
+        return Err(fail(format!(
+            "luminaire multiplier {multiplier} must be a number ≥ 0"
+        )));
+    }
+    let color = Vec3::from(l.color.unwrap_or([1.0, 1.0, 1.0]));
+    if !color.is_finite() || color.min_element() < 0.0 || luminance(color) <= 0.0 {
+        return Err(fail(format!(
+            "luminaire color {color} must be non-negative with a luminance above 0"
+        )));
+    }
+    let ies_path = dir.join(&l.ies);
+    let bytes = files.read(&ies_path).map_err(|cause| Error::Read {
+        path: ies_path.clone(),
+        cause,
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    let photometry = Photometry::parse(&ies_path, &text)?;
+    Ok(Luminaire {
+        position,
+        aim,
+        c0: c0.normalize(),
+        tint: color / luminance(color) * multiplier,
+        photometry: std::sync::Arc::new(photometry),
+    })
+}
+
+/// A grid from its table, checked; `fail` names the table's line and the key at fault.
+fn grid(g: GridToml, fail: &dyn Fn(String) -> Error) -> Result<Grid> {
+    let (origin, u, v) = (Vec3::from(g.origin), Vec3::from(g.u), Vec3::from(g.v));
+    let name = &g.name;
+    for (key, value) in [("origin", origin), ("u", u), ("v", v)] {
+        if let Some(problem) = validate::position(value) {
+            return Err(fail(format!("grid '{name}': {key}: {problem}")));
+        }
+    }
+    for (key, edge) in [("u", u), ("v", v)] {
+        if edge.length_squared() <= 0.0 {
+            return Err(fail(format!("grid '{name}': {key} has zero length")));
+        }
+    }
+    let cross = u.cross(v);
+    if cross.length() <= 1e-6 * u.length() * v.length() {
+        return Err(fail(format!("grid '{name}': u {u} is parallel to v {v}")));
+    }
+    let normal = g.normal.map_or(cross, Vec3::from);
+    if !normal.is_finite() || normal.length_squared() <= 0.0 {
+        return Err(fail(format!(
+            "grid '{name}': normal {normal} is not a direction"
+        )));
+    }
+    let spacing = g.spacing.unwrap_or_else(|| Grid::default_spacing(u, v));
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(fail(format!(
+            "grid '{name}': spacing {spacing} must be a positive length"
+        )));
+    }
+    let Some((n_u, n_v)) = Grid::counts(u, v, spacing) else {
+        return Err(fail(format!(
+            "grid '{name}': spacing {spacing} would make more than {} points",
+            super::MAX_GRID_POINTS
+        )));
+    };
+    Ok(Grid {
+        name: g.name,
+        origin,
+        u,
+        v,
+        normal: normal.normalize(),
+        spacing,
+        n_u,
+        n_v,
+    })
 }
 
 /// Reads and checks a scene file.
@@ -124,6 +257,37 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         point_lights.push(light);
     }
 
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut luminaires = Vec::with_capacity(parsed.luminaire.len());
+    for l in parsed.luminaire {
+        let span = l.span();
+        let fail = |problem: String| at(span.clone(), problem);
+        luminaires.push(luminaire(files, dir, l.into_inner(), &fail)?);
+    }
+    let mut grids: Vec<Grid> = Vec::with_capacity(parsed.grid.len());
+    for g in parsed.grid {
+        let span = g.span();
+        let fail = |problem: String| at(span.clone(), problem);
+        let g = grid(g.into_inner(), &fail)?;
+        if grids.iter().any(|other| other.name == g.name) {
+            return Err(fail(format!("grid '{}': name used twice", g.name)));
+        }
+        grids.push(g);
+    }
+    let units = match parsed.units {
+        None => Units::Radiometric,
+        Some(u) => match u.get_ref().as_str() {
+            "radiometric" => Units::Radiometric,
+            "photometric" => Units::Photometric,
+            other => {
+                return Err(at(
+                    u.span(),
+                    format!("units = \"{other}\": either \"radiometric\" or \"photometric\""),
+                ))
+            }
+        },
+    };
+
     let mut solver = SolverDefaults::default();
     if let Some(s) = parsed.solver {
         let span = s.span();
@@ -146,7 +310,6 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
             "obj is empty: it must name the OBJ file".into(),
         ));
     }
-    let dir = path.parent().unwrap_or(Path::new(""));
     let name = Path::new(&obj).file_name().map(|n| n.to_string_lossy());
     let obj_notes = name
         .map(|name| {
@@ -162,6 +325,9 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         two_sided: parsed.two_sided,
         camera,
         point_lights,
+        luminaires,
+        units,
+        grids,
         solver,
         obj_line: line_of(text, obj_span.start),
         obj_notes,

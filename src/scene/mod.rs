@@ -4,6 +4,8 @@
 
 mod camera;
 mod file;
+mod grid;
+mod luminaire;
 mod obj;
 mod source;
 mod surfaces;
@@ -16,6 +18,8 @@ use glam::{DVec3, Vec3};
 
 use crate::error::{Error, Result};
 pub use camera::Camera;
+pub use grid::{Grid, MAX_GRID_POINTS};
+pub use luminaire::{luminance, Luminaire, PointSource};
 pub use source::{Disk, Memory, Source};
 
 /// A diffuse material: reflectance and emitted radiance, RGB.
@@ -80,6 +84,51 @@ impl PointLight {
     /// Emitted power, 4π·I.
     pub fn power(&self) -> DVec3 {
         4.0 * std::f64::consts::PI * self.intensity.as_dvec3()
+    }
+}
+
+/// What a scene's numbers mean (scene-format.md, "Units"). The solver does not care: it
+/// carries radiance as luminance alike; only the labels of results change.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Units {
+    /// W/sr, W·sr⁻¹·m⁻², W/m².
+    #[default]
+    Radiometric,
+    /// Candela, cd/m², lux.
+    Photometric,
+}
+
+impl Units {
+    /// The unit of irradiance (illuminance).
+    pub fn irradiance(self) -> &'static str {
+        match self {
+            Units::Radiometric => "W/m²",
+            Units::Photometric => "lx",
+        }
+    }
+
+    /// The unit of radiance (luminance).
+    pub fn radiance(self) -> &'static str {
+        match self {
+            Units::Radiometric => "W·sr⁻¹·m⁻²",
+            Units::Photometric => "cd/m²",
+        }
+    }
+
+    /// The unit of a point's intensity.
+    pub fn intensity(self) -> &'static str {
+        match self {
+            Units::Radiometric => "W/sr",
+            Units::Photometric => "cd",
+        }
+    }
+
+    /// The unit of flux (power).
+    pub fn flux(self) -> &'static str {
+        match self {
+            Units::Radiometric => "W",
+            Units::Photometric => "lm",
+        }
     }
 }
 
@@ -181,6 +230,12 @@ pub struct Scene {
     pub surfaces: Vec<Surface>,
     /// Point lights.
     pub point_lights: Vec<PointLight>,
+    /// Luminaires (IES distributions) from the scene file.
+    pub luminaires: Vec<Luminaire>,
+    /// The scene's units: what its numbers mean, and what results are reported in.
+    pub units: Units,
+    /// Calculation surfaces where `meshlight lux` measures illuminance.
+    pub grids: Vec<Grid>,
     /// The camera.
     pub camera: Camera,
     /// Whether non-emitting faces reflect on both sides.
@@ -255,6 +310,9 @@ impl Scene {
             solver: file.solver,
         };
         let mut scene = Scene::build(path, parts, &file.obj)?;
+        scene.luminaires = file.luminaires;
+        scene.units = file.units;
+        scene.grids = file.grids;
         warnings.append(&mut scene.warnings);
         scene.warnings = warnings;
         Ok(scene)
@@ -301,6 +359,9 @@ impl Scene {
             triangles,
             surfaces,
             point_lights,
+            luminaires: Vec::new(),
+            units: Units::default(),
+            grids: Vec::new(),
             camera,
             two_sided,
             solver,
@@ -352,6 +413,16 @@ impl Scene {
             light.position *= s;
             light.intensity *= s * s;
         }
+        for l in &mut scene.luminaires {
+            l.position *= s;
+            l.tint *= s * s;
+        }
+        for g in &mut scene.grids {
+            g.origin *= s;
+            g.u *= s;
+            g.v *= s;
+            g.spacing *= s;
+        }
         scene.camera.position *= s;
         scene.camera.look_at *= s;
         scene.bounds = Bounds {
@@ -372,8 +443,12 @@ impl Scene {
         for light in &mut scene.point_lights {
             light.intensity *= f;
         }
+        for l in &mut scene.luminaires {
+            l.tint *= f;
+        }
         let lights = scene.materials.iter().map(|m| m.ke);
         let lights = lights.chain(scene.point_lights.iter().map(|l| l.intensity));
+        let lights = lights.chain(scene.luminaires.iter().map(|l| l.tint));
         if f.is_nan() || f < 0.0 || !lights.into_iter().all(|v| v.is_finite()) {
             return Err(Error::argument(
                 "light scale",
@@ -406,6 +481,22 @@ impl Scene {
     pub fn emitted_power(&self) -> DVec3 {
         let area: DVec3 = self.emitters().map(|(_, p)| p).sum();
         let points: DVec3 = self.point_lights.iter().map(PointLight::power).sum();
-        area + points
+        let luminaires: DVec3 = self.luminaires.iter().map(Luminaire::flux).sum();
+        area + points + luminaires
+    }
+
+    /// Every light at a point: the point lights, then the luminaires.
+    pub fn point_sources(&self) -> Vec<PointSource> {
+        let points = self.point_lights.iter().map(|l| PointSource {
+            position: l.position,
+            intensity: l.intensity,
+            luminaire: None,
+        });
+        let luminaires = self.luminaires.iter().map(|l| PointSource {
+            position: l.position,
+            intensity: l.tint,
+            luminaire: Some(l.clone()),
+        });
+        points.chain(luminaires).collect()
     }
 }

@@ -36,6 +36,7 @@ pub use options::{
 use phases::{AddedSamples, Solve};
 pub use progress::{Control, Phase, Progress};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
+pub(crate) use warm::emission as emission_of;
 use warm::reflectance;
 
 /// The solved samples.

@@ -91,7 +91,7 @@ pub(crate) fn point_lights(
     lift: f32,
     threads: usize,
 ) -> Result<u64> {
-    let lights = &scene.point_lights;
+    let lights = &scene.point_sources();
     if lights.is_empty() {
         return Ok(0);
     }
@@ -114,7 +114,7 @@ pub(crate) fn point_lights(
                         a: from,
                         b: light.position,
                     });
-                    gains.push((k, p.kd * light.intensity.as_dvec3() * cos / r2));
+                    gains.push((k, p.kd * light.towards(-to).as_dvec3() * cos / r2));
                 }
             }
         }

@@ -1,0 +1,126 @@
+//! `meshlight lux`: solve, then measure illuminance at every grid's points; per grid a CSV
+//! (`x,y,z,E`), a false-colour plan, and a summary line.
+
+use std::io::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use meshlight::lux::{illuminance, LuxOptions};
+use meshlight::scene::luminance;
+use meshlight::{Scene, Solution, Visibility};
+
+/// One grid's numbers: Emin, Eavg, Emax (luminance-weighted).
+pub struct Summary {
+    /// The smallest.
+    pub min: f64,
+    /// The mean.
+    pub avg: f64,
+    /// The largest.
+    pub max: f64,
+}
+
+impl Summary {
+    fn of(values: &[f64]) -> Summary {
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let avg = values.iter().sum::<f64>() / values.len().max(1) as f64;
+        Summary { min, avg, max }
+    }
+
+    /// Emin / Eavg.
+    fn uniformity(&self) -> f64 {
+        if self.avg > 0.0 {
+            self.min / self.avg
+        } else {
+            0.0
+        }
+    }
+
+    /// Emin / Emax.
+    fn diversity(&self) -> f64 {
+        if self.max > 0.0 {
+            self.min / self.max
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Measures every grid, writing `DIR/<name>.csv` and `DIR/<name>.png` and printing a line per
+/// grid.
+pub fn run(
+    scene: &Scene,
+    solution: &Solution,
+    vis: &dyn Visibility,
+    options: &LuxOptions,
+    dir: &Path,
+) -> Result<()> {
+    if scene.grids.is_empty() {
+        anyhow::bail!(
+            "{}: the scene has no [[grid]] to measure (scene-format.md, \"Grids\")",
+            scene.path.display()
+        );
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    let unit = scene.units.irradiance();
+    for grid in &scene.grids {
+        let started = Instant::now();
+        let points = grid.points();
+        eprint!("grid '{}': {} points", grid.name, points.len());
+        let mut last = -1i32;
+        let e = illuminance(scene, solution, vis, grid, options, &mut |f| {
+            let pct = (100.0 * f) as i32;
+            if pct / 10 > last / 10 {
+                last = pct;
+                eprint!("\rgrid '{}': {} points, {pct}%   ", grid.name, points.len());
+            }
+        })?;
+        eprintln!();
+        let values: Vec<f64> = e
+            .iter()
+            .map(|v| f64::from(luminance(v.as_vec3())))
+            .collect();
+        let stem = grid.file_stem();
+        let csv = dir.join(format!("{stem}.csv"));
+        let mut out = std::io::BufWriter::new(
+            std::fs::File::create(&csv)
+                .with_context(|| format!("{}: cannot write", csv.display()))?,
+        );
+        writeln!(out, "x,y,z,E")?;
+        for (p, v) in points.iter().zip(&values) {
+            writeln!(out, "{},{},{},{v}", p.x, p.y, p.z)?;
+        }
+        out.flush()?;
+        let s = Summary::of(&values);
+        let line = format!(
+            "grid '{}': {} points, Emin {:.4} {unit}, Eavg {:.4} {unit}, Emax {:.4} {unit}, U0 = Emin/Eavg {:.3}, Emin/Emax {:.3}; {:.2} s",
+            grid.name,
+            values.len(),
+            s.min,
+            s.avg,
+            s.max,
+            s.uniformity(),
+            s.diversity(),
+            started.elapsed().as_secs_f64()
+        );
+        let png = dir.join(format!("{stem}.png"));
+        super::plot::plan_png(
+            &png,
+            (grid.n_u, grid.n_v),
+            &values,
+            (0.0, s.max),
+            unit,
+            &format!("{} ({unit})", grid.name),
+            &[
+                format!("Emin {:.4}", s.min),
+                format!("Eavg {:.4}", s.avg),
+                format!("Emax {:.4}", s.max),
+                format!("U0 {:.3}", s.uniformity()),
+            ],
+        )?;
+        println!("{line}");
+        println!("wrote {} and {}", csv.display(), png.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,115 @@
+//! Illuminance at the points of a grid (scene-format.md, "Grids"): a grid floats in the
+//! scene, so interpolating a surface's radiosity is not enough. Direct light comes from the
+//! lights themselves with the solver's estimator (point lights and luminaires by a shadow
+//! ray, area lights by Lambert's formula × the visible share of stratified shadow rays);
+//! inter-reflected light is gathered from every solved sample — its reflected radiosity
+//! (B − emission) through the point-to-disc form factor Aⱼ cosθ cosθⱼ / (πr² + Aⱼ), with a
+//! visibility ray.
+
+use glam::{DVec3, Vec3};
+
+use crate::error::Result;
+use crate::light::DirectLight;
+use crate::parallel::for_chunks_reporting;
+use crate::scene::{Grid, Scene};
+use crate::solver::Solution;
+use crate::visibility::{Segment, Visibility};
+
+/// How grid points are measured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LuxOptions {
+    /// Shadow rays per area light and point.
+    pub light_samples: u32,
+    /// Seed of the shadow rays.
+    pub seed: u64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+impl Default for LuxOptions {
+    fn default() -> Self {
+        LuxOptions {
+            light_samples: 64,
+            seed: 1,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        }
+    }
+}
+
+/// Illuminance (RGB; W/m², or lux in a photometric scene) at each of `grid`'s points, in
+/// [`Grid::points`] order: direct + inter-reflected. `progress` hears the share done.
+pub fn illuminance(
+    scene: &Scene,
+    solution: &Solution,
+    vis: &dyn Visibility,
+    grid: &Grid,
+    options: &LuxOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<DVec3>> {
+    crate::parallel::guarded("the illuminance gather", || {
+        solution.check_fits(scene)?;
+        let points = grid.points();
+        let n = grid.normal;
+        // Direct light: the solver's estimator at the points, facing the grid's normal.
+        let light = DirectLight::new(scene, options.light_samples);
+        let at: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, n)).collect();
+        let ids: Vec<u32> = (0..points.len() as u32).collect();
+        let (direct, _) = light.at(vis, &at, &ids, options.seed, options.threads, &mut |f| {
+            progress(0.2 * f)
+        })?;
+        // Inter-reflected light from every sample.
+        let s = &solution.samples;
+        let reflected: Vec<DVec3> = (0..s.len())
+            .map(|k| solution.radiosity[k] - crate::solver::emission_of(scene, s, k))
+            .collect();
+        let lift = crate::visibility::lift(scene);
+        let mut gathered = vec![DVec3::ZERO; points.len()];
+        let gather = |first: usize, out: &mut [DVec3]| {
+            for (o, &x) in out.iter_mut().zip(&points[first..]) {
+                let mut segments = Vec::new();
+                let mut shares = Vec::new();
+                for (k, reflected) in reflected.iter().enumerate() {
+                    if reflected.max_element() <= 0.0 {
+                        continue;
+                    }
+                    let (y, m) = (s.position[k], s.normal[k]);
+                    let d = y - x;
+                    let r2 = d.length_squared();
+                    if r2 <= 0.0 {
+                        continue;
+                    }
+                    let r = r2.sqrt();
+                    let (cos_x, cos_y) = (n.dot(d) / r, -m.dot(d) / r);
+                    if cos_x <= 0.0 || cos_y <= 0.0 {
+                        continue;
+                    }
+                    let area = s.area[k];
+                    let factor = area * f64::from(cos_x * cos_y)
+                        / (std::f64::consts::PI * f64::from(r2) + area);
+                    segments.push(Segment {
+                        a: x,
+                        b: y + lift * m,
+                    });
+                    shares.push(*reflected * factor);
+                }
+                let mut blocked = vec![false; segments.len()];
+                vis.occluded(&segments, &mut blocked)?;
+                *o = shares
+                    .iter()
+                    .zip(&blocked)
+                    .filter(|(_, &b)| !b)
+                    .map(|(e, _)| *e)
+                    .sum();
+            }
+            Ok(())
+        };
+        for_chunks_reporting(&mut gathered, 4, options.threads, gather, &mut |f| {
+            progress(0.2 + 0.8 * f)
+        })?;
+        Ok(direct
+            .iter()
+            .zip(&gathered)
+            .map(|(d, g)| d.irradiance + *g)
+            .collect())
+    })
+}
