@@ -113,3 +113,31 @@ pub fn illuminance(
             .collect())
     })
 }
+
+/// Which of `grid`'s points lie inside a solid (a pedestal standing through a work plane): the
+/// first surface a ray along the grid's normal meets is seen from behind. Such points receive
+/// nothing; a summary leaves them out.
+pub fn enclosed(scene: &Scene, vis: &dyn Visibility, grid: &Grid) -> Result<Vec<bool>> {
+    let points = grid.points();
+    let reach = 2.0 * scene.bounds.diagonal();
+    let rays: Vec<crate::visibility::Ray> = points
+        .iter()
+        .map(|&p| crate::visibility::Ray {
+            origin: p,
+            dir: grid.normal,
+            t_min: 0.0,
+            t_max: reach,
+        })
+        .collect();
+    let hits = crate::visibility::intersect_all(vis, &rays, 1)?;
+    Ok(hits
+        .iter()
+        .map(|h| {
+            h.is_some_and(|h| {
+                let t = &scene.triangles[h.triangle as usize];
+                // Seen from behind, and its back is black (a solid's inside).
+                grid.normal.dot(t.normal) > 0.0 && !scene.two_sided
+            })
+        })
+        .collect())
+}

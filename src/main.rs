@@ -41,8 +41,14 @@ fn run(args: Args) -> anyhow::Result<()> {
             spp,
             time,
             patch_size,
+            false_color,
+            range,
+            log,
         } => {
             let started = std::time::Instant::now();
+            if method != Method::Meshless && false_color.is_some() {
+                anyhow::bail!("--false-color works with --method meshless only");
+            }
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
             let vis = cli::backend_from(&solve.knobs).build(&scene)?;
             if method == Method::Pathtrace {
@@ -120,6 +126,10 @@ fn run(args: Args) -> anyhow::Result<()> {
             let render_options = meshlight::RenderOptions {
                 threads: options.threads,
                 supersample,
+                quantity: match false_color {
+                    Some(cli::FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
+                    _ => meshlight::Quantity::Radiance,
+                },
             };
             let t = std::time::Instant::now();
             let (image, stats) =
@@ -127,7 +137,12 @@ fn run(args: Args) -> anyhow::Result<()> {
             let render_seconds = t.elapsed().as_secs_f64();
             image.write_exr(&output)?;
             let png = output.with_extension("png");
-            image.write_png(&png, image.auto_exposure())?;
+            match false_color {
+                None => image.write_png(&png, image.auto_exposure())?,
+                Some(kind) => {
+                    cli::false_colour_render(&image, &png, kind, range, log, scene.units)?
+                }
+            }
             print!(
                 "{}",
                 cli::solve_summary(&scene, &solution, &options, vis.name())

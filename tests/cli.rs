@@ -427,3 +427,52 @@ fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
             > 1000
     );
 }
+
+#[test]
+fn false_colour_renders_hold_the_illuminance_and_refuse_bad_ranges() {
+    // The furnace: every surface receives E = π · 0.2 (radiance 0.2 from all round).
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("e.exr");
+    let out = meshlight(&[
+        "render",
+        "scenes/box/scene.toml",
+        "-o",
+        exr.to_str().unwrap(),
+        "--false-color",
+        "illuminance",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let image = meshlight::Image::read_exr(&exr).unwrap();
+    let want = std::f64::consts::PI * 0.2;
+    assert!(
+        (image.mean() / want - 1.0).abs() < 0.02,
+        "{} vs {want}",
+        image.mean()
+    );
+    assert!(std::fs::metadata(exr.with_extension("png")).unwrap().len() > 1000);
+    for (args, problem) in [
+        (
+            vec!["--false-color", "luminance", "--range", "5:1"],
+            "MIN must be below MAX",
+        ),
+        (
+            vec!["--false-color", "luminance", "--range", "0:1", "--log"],
+            "--log needs a range above 0",
+        ),
+        (
+            vec!["--false-color", "luminance", "--method", "pathtrace"],
+            "meshless only",
+        ),
+    ] {
+        let mut all = vec![
+            "render",
+            "scenes/box/scene.toml",
+            "-o",
+            exr.to_str().unwrap(),
+        ];
+        all.extend(args);
+        let out = meshlight(&all);
+        assert!(!out.status.success());
+        assert!(text(&out.stderr).contains(problem), "{}", text(&out.stderr));
+    }
+}

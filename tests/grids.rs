@@ -199,3 +199,46 @@ fn in_the_furnace_a_floating_grid_measures_pi_times_the_radiance_all_round() {
         }
     }
 }
+
+#[test]
+fn points_inside_a_solid_are_found_and_left_out() {
+    // A 1 m cube standing on a floor (faces outwards: its box built with y swapped), a grid
+    // through it at 0.5 m: the 2 × 2 of its 8 × 8 points with |x|, |z| < 0.5 are inside.
+    let mut b = common::Builder::default();
+    let grey = b.material(common::material("grey", 0.5, 0.0));
+    b.quad(
+        [
+            Vec3::new(-5.0, 0.0, -5.0),
+            Vec3::new(-5.0, 0.0, 5.0),
+            Vec3::new(5.0, 0.0, 5.0),
+            Vec3::new(5.0, 0.0, -5.0),
+        ],
+        grey,
+    );
+    b.room(
+        Vec3::new(-0.5, 1.0, -0.5),
+        Vec3::new(0.5, 0.0, 0.5),
+        grey,
+        &["+y"],
+    );
+    let mut scene = b.scene(common::camera(Vec3::new(0.0, 3.0, -6.0), Vec3::ZERO, 8));
+    scene.grids.push(Grid {
+        name: "through the cube".into(),
+        origin: Vec3::new(-2.0, 0.5, -2.0),
+        u: Vec3::new(4.0, 0.0, 0.0),
+        v: Vec3::new(0.0, 0.0, 4.0),
+        normal: Vec3::Y,
+        spacing: 0.5,
+        n_u: 8,
+        n_v: 8,
+    });
+    let grid = &scene.grids[0];
+    for backend in backends() {
+        let vis = backend.build(&scene).unwrap();
+        let inside = meshlight::lux::enclosed(&scene, vis.as_ref(), grid).unwrap();
+        for (p, &i) in grid.points().iter().zip(&inside) {
+            assert_eq!(i, p.x.abs() < 0.5 && p.z.abs() < 0.5, "{backend} at {p}");
+        }
+        assert_eq!(inside.iter().filter(|&&i| i).count(), 4);
+    }
+}

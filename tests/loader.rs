@@ -92,3 +92,19 @@ fn gallery_is_gallery_scale() {
     assert_eq!(s.bounds.max, glam::Vec3::new(24.0, 4.5, 16.0));
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
 }
+
+#[test]
+fn the_designed_gallery_has_its_luminaires_and_grids() {
+    let path = meshlight_gallery::ensure().expect("generate the gallery");
+    let design = path.with_file_name("design.toml");
+    let s = meshlight::Scene::load(&design).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.units, meshlight::scene::Units::Photometric);
+    assert_eq!((s.luminaires.len(), s.grids.len()), (11, 3));
+    // The downlight was written as I₀ cos³γ for 1,800 lm: Φ = 2π I₀ / 4 (by hand).
+    let flux = s.luminaires[0].flux().y;
+    assert!((flux / 1800.0 - 1.0).abs() < 0.005, "{flux} lm");
+    // Grid counts by the spec's rule: 7.8 × 11.7 m at 0.2 · 5^log10(11.7) = 1.1 m → 7 × 11.
+    assert_eq!((s.grids[0].n_u, s.grids[0].n_v), (7, 11));
+    assert_eq!((s.grids[1].n_u, s.grids[1].n_v), (16, 11));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}

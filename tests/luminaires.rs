@@ -59,6 +59,7 @@ fn check(scene: &Scene, expected: impl Fn(Vec3) -> f64) {
             );
             worst = worst.max((got.y - want).abs() / want.max(1e-3));
         }
+        eprintln!("{backend}: worst relative error {worst:.2e}");
         assert!(worst < 1e-3, "{backend}: worst relative error {worst}");
     }
 }

@@ -85,6 +85,34 @@ pub struct Knobs {
     pub seed: Option<u64>,
 }
 
+/// What `render --false-color` shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FalseColor {
+    /// The luminance (radiance) seen.
+    Luminance,
+    /// The illuminance (irradiance) on the surface seen.
+    Illuminance,
+}
+
+/// MIN:MAX, two numbers with MIN < MAX.
+pub fn parse_range(text: &str) -> Result<(f64, f64), String> {
+    let (a, b) = text
+        .split_once(':')
+        .ok_or_else(|| format!("'{text}': write MIN:MAX, e.g. 0:500"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{s}' is not a number"))
+    };
+    let (lo, hi) = (parse(a)?, parse(b)?);
+    if lo >= hi {
+        return Err(format!("'{text}': MIN must be below MAX"));
+    }
+    Ok((lo, hi))
+}
+
 /// How `render` computes its image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
@@ -121,6 +149,18 @@ pub enum Command {
         /// Patches: the side of the square patches (default: the solver's ε).
         #[arg(long)]
         patch_size: Option<f32>,
+        /// Write the PNG as a false-colour picture with a legend in the scene's unit instead of
+        /// a tone-mapped one: the luminance seen, or the illuminance on the surface seen (then
+        /// the EXR holds the illuminance too).
+        #[arg(long, value_enum)]
+        false_color: Option<FalseColor>,
+        /// The false colours' range, MIN:MAX (default 0 to the 99th percentile; with --log,
+        /// the 1st to the 99th percentile of the non-zero values).
+        #[arg(long, value_parser = parse_range)]
+        range: Option<(f64, f64)>,
+        /// Logarithmic false colours.
+        #[arg(long)]
+        log: bool,
     },
     /// Compare an image with a reference: mean absolute error / mean (the paper's measure) and more.
     Compare {

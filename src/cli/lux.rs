@@ -81,6 +81,14 @@ pub fn run(
             .iter()
             .map(|v| f64::from(luminance(v.as_vec3())))
             .collect();
+        let inside = meshlight::lux::enclosed(scene, vis, grid)?;
+        let open: Vec<f64> = values
+            .iter()
+            .zip(&inside)
+            .filter(|(_, &i)| !i)
+            .map(|(v, _)| *v)
+            .collect();
+        let left_out = values.len() - open.len();
         let stem = grid.file_stem();
         let csv = dir.join(format!("{stem}.csv"));
         let mut out = std::io::BufWriter::new(
@@ -92,11 +100,16 @@ pub fn run(
             writeln!(out, "{},{},{},{v}", p.x, p.y, p.z)?;
         }
         out.flush()?;
-        let s = Summary::of(&values);
+        let s = Summary::of(&open);
         let line = format!(
-            "grid '{}': {} points, Emin {:.4} {unit}, Eavg {:.4} {unit}, Emax {:.4} {unit}, U0 = Emin/Eavg {:.3}, Emin/Emax {:.3}; {:.2} s",
+            "grid '{}': {} points{}, Emin {:.4} {unit}, Eavg {:.4} {unit}, Emax {:.4} {unit}, U0 = Emin/Eavg {:.3}, Emin/Emax {:.3}; {:.2} s",
             grid.name,
             values.len(),
+            if left_out > 0 {
+                format!(" ({left_out} inside solids left out)")
+            } else {
+                String::new()
+            },
             s.min,
             s.avg,
             s.max,

@@ -204,6 +204,77 @@ pub fn sequential(t: f32) -> [u8; 3] {
     [0, 1, 2].map(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0 + 0.5) as u8)
 }
 
+/// Writes a false-colour picture of per-pixel `values` (row-major, `width` × `height`) on the
+/// sequential map from `low` to `high` (logarithmic if `log`; then `low` must be > 0), with a
+/// colour bar labelled in `unit` and a title.
+pub fn sequential_png(
+    path: &Path,
+    (width, height): (u32, u32),
+    values: &[f64],
+    (low, high, log): (f64, f64, bool),
+    unit: &str,
+    title: &str,
+) -> Result<()> {
+    font()?;
+    let level = |v: f64| -> f32 {
+        let t = if log {
+            (v.max(low) / low).ln() / (high / low).ln()
+        } else {
+            (v - low) / (high - low)
+        };
+        t as f32
+    };
+    let legend = 200u32;
+    let (w, h) = (width + legend, height.max(300));
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        for y in 0..height {
+            for x in 0..width {
+                let [r, g, b] = sequential(level(values[(y * width + x) as usize]));
+                root.draw_pixel((x as i32, y as i32), &RGBColor(r, g, b))
+                    .map_err(plot_error)?;
+            }
+        }
+        let style = ("sans-serif", 14).into_font();
+        let left = width as i32 + 14;
+        root.draw(&Text::new(title.to_string(), (left, 8), style.clone()))
+            .map_err(plot_error)?;
+        let (top, bar) = (34i32, 180i32);
+        for i in 0..bar {
+            let [r, g, b] = sequential(1.0 - i as f32 / (bar - 1) as f32);
+            root.draw(&Rectangle::new(
+                [(left, top + i), (left + 22, top + i + 1)],
+                RGBColor(r, g, b).filled(),
+            ))
+            .map_err(plot_error)?;
+        }
+        for k in 0..5 {
+            let t = 1.0 - f64::from(k) / 4.0;
+            let value = if log {
+                low * (high / low).powf(t)
+            } else {
+                low + (high - low) * t
+            };
+            let y = top + (bar - 1) * k / 4;
+            root.draw(&PathElement::new(
+                vec![(left + 22, y), (left + 27, y)],
+                BLACK,
+            ))
+            .map_err(plot_error)?;
+            root.draw(&Text::new(
+                format!("{value:.4} {unit}"),
+                (left + 31, y - 7),
+                style.clone(),
+            ))
+            .map_err(plot_error)?;
+        }
+        root.present().map_err(plot_error)?;
+    }
+    write_rgb(path, w, h, rgb)
+}
+
 /// Writes a false-colour plan of a grid's values (`nu` × `nv`, row by row along u) from
 /// `low` to `high`, cells scaled to about 480 pixels along the longer side, with iso-lines at
 /// the legend's five values, a colour bar labelled in `unit`, a title and caption lines.

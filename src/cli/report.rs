@@ -90,7 +90,7 @@ pub fn info(scene: &Scene) -> String {
         let flux = l.flux();
         let _ = writeln!(
             s,
-            "  at {}: aim {}, flux {:.1} {} (luminance of {} {})",
+            "  at {}: aim {}, flux {:.1} {} (RGB {} {})",
             v3(l.position),
             v3(l.aim),
             meshlight::scene::luminance(flux.as_vec3()),
@@ -379,5 +379,48 @@ pub fn render_summary(image: &Image, stats: &RenderStats, seconds: f64) -> Strin
     format!(
         "render {}x{}: {} camera rays ({} edge pixels supersampled), {} interpolation queries, {:.3} s; mean radiance {:.5}\n",
         image.width, image.height, stats.camera_rays, stats.supersampled_pixels, stats.interpolation_queries, seconds, image.mean()
+    )
+}
+
+/// Writes `image` as a false-colour PNG of its luminance, with a legend in `units`.
+pub fn false_colour_render(
+    image: &Image,
+    path: &std::path::Path,
+    kind: super::FalseColor,
+    range: Option<(f64, f64)>,
+    log: bool,
+    units: meshlight::scene::Units,
+) -> anyhow::Result<()> {
+    let values: Vec<f64> = image
+        .pixels
+        .iter()
+        .map(|p| f64::from(meshlight::scene::luminance(*p)))
+        .collect();
+    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    sorted.sort_unstable_by(f64::total_cmp);
+    let percentile = |v: &[f64], q: usize| v.get(v.len() * q / 100).copied().unwrap_or(0.0);
+    let (low, high) = match range {
+        Some(r) => r,
+        None if log => {
+            let positive: Vec<f64> = sorted.iter().copied().filter(|&v| v > 0.0).collect();
+            (percentile(&positive, 1), percentile(&positive, 99))
+        }
+        None => (0.0, percentile(&sorted, 99)),
+    };
+    if log && low <= 0.0 {
+        anyhow::bail!("--log needs a range above 0 (the image has no lit pixel, or MIN ≤ 0)");
+    }
+    let high = if high > low { high } else { low + 1.0 };
+    let (unit, name) = match kind {
+        super::FalseColor::Luminance => (units.radiance(), "luminance"),
+        super::FalseColor::Illuminance => (units.irradiance(), "illuminance"),
+    };
+    super::plot::sequential_png(
+        path,
+        (image.width, image.height),
+        &values,
+        (low, high, log),
+        unit,
+        &format!("{name} ({unit})"),
     )
 }

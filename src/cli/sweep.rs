@@ -400,6 +400,7 @@ fn measure(
                 &meshlight::RenderOptions {
                     threads: options.threads,
                     supersample: extra.supersample,
+                    ..meshlight::RenderOptions::default()
                 },
             )?;
             row.seconds[5] = t.elapsed().as_secs_f64();

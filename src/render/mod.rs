@@ -28,6 +28,19 @@ pub struct RenderOptions {
     pub threads: usize,
     /// Pixels on an edge between surfaces get `supersample × supersample` rays (1 = never).
     pub supersample: u32,
+    /// What each pixel holds.
+    pub quantity: Quantity,
+}
+
+/// What a rendered image holds per pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Quantity {
+    /// Outgoing radiance (luminance in a photometric scene): what a camera sees.
+    #[default]
+    Radiance,
+    /// Irradiance (illuminance) on the surface seen: the light arriving there, whatever its
+    /// reflectance; emitters without samples and misses are 0.
+    Irradiance,
 }
 
 impl Default for RenderOptions {
@@ -35,6 +48,7 @@ impl Default for RenderOptions {
         RenderOptions {
             threads: crate::solver::Options::default().threads,
             supersample: 4,
+            quantity: Quantity::Radiance,
         }
     }
 }
@@ -73,7 +87,7 @@ fn render_unguarded(
     camera.check()?;
     solution.check_fits(scene)?;
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let shader = Shader::new(scene, solution, vis);
+    let shader = Shader::new(scene, solution, vis, options.quantity);
     let mut stats = RenderStats::default();
 
     // Centre rays: radiance and the side each pixel sees.
@@ -177,6 +191,8 @@ struct Shader<'a> {
     lift: f32,
     /// Largest kernel support among each side's samples (0: the side has none).
     support: Vec<f32>,
+    /// What the pixels hold.
+    quantity: Quantity,
 }
 
 /// A hit waiting for its visibility answers.
@@ -192,7 +208,12 @@ struct Pending {
 }
 
 impl<'a> Shader<'a> {
-    fn new(scene: &'a Scene, solution: &'a Solution, vis: &'a dyn Visibility) -> Self {
+    fn new(
+        scene: &'a Scene,
+        solution: &'a Solution,
+        vis: &'a dyn Visibility,
+        quantity: Quantity,
+    ) -> Self {
         let s = &solution.samples;
         let mut support = vec![0.0f32; 2 * scene.surfaces.len()];
         for (&side, &d) in s.side.iter().zip(&s.radius) {
@@ -204,6 +225,15 @@ impl<'a> Shader<'a> {
             vis,
             lift: crate::visibility::lift(scene),
             support,
+            quantity,
+        }
+    }
+
+    /// What sample k shows: its radiance B/π, or its irradiance.
+    fn value(&self, k: usize) -> glam::DVec3 {
+        match self.quantity {
+            Quantity::Radiance => self.solution.radiosity[k] / std::f64::consts::PI,
+            Quantity::Irradiance => self.solution.irradiance[k],
         }
     }
 
@@ -264,7 +294,11 @@ impl<'a> Shader<'a> {
             let reach = self.support[side as usize];
             if reach <= 0.0 {
                 let material = self.scene.material_of(tri.surface);
-                let fixed = if back { Vec3::ZERO } else { material.ke };
+                let fixed = if back || self.quantity == Quantity::Irradiance {
+                    Vec3::ZERO
+                } else {
+                    material.ke
+                };
                 pending.push(Pending {
                     side,
                     candidates: 0..0,
@@ -325,7 +359,7 @@ impl<'a> Shader<'a> {
                                 && (!alike || self.sample_covered(k as usize) == p.covered)
                             {
                                 wsum += f64::from(w);
-                                sum += f64::from(w) * self.solution.radiosity[k as usize];
+                                sum += f64::from(w) * self.value(k as usize);
                             }
                         }
                         if wsum > 0.0 {
@@ -333,7 +367,7 @@ impl<'a> Shader<'a> {
                         }
                     }
                     if wsum > 0.0 {
-                        (sum / wsum / std::f64::consts::PI).as_vec3()
+                        (sum / wsum).as_vec3()
                     } else {
                         let (l, q) = self.nearest_visible(p.side, p.point)?;
                         queries += q;
@@ -379,10 +413,7 @@ impl<'a> Shader<'a> {
             queries += segments.len() as u64;
             if let Some(i) = blocked.iter().position(|b| !b) {
                 let k = near[i].0 as usize;
-                return Ok((
-                    (self.solution.radiosity[k] / std::f64::consts::PI).as_vec3(),
-                    queries,
-                ));
+                return Ok((self.value(k).as_vec3(), queries));
             }
         }
         Ok((Vec3::ZERO, queries))
