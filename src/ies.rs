@@ -469,6 +469,10 @@ mod tests {
         let p = parse(&file(1.0, 1.0, &v, &[0.0], &[row])).unwrap();
         let flux = p.flux();
         let exact = std::f64::consts::PI * 1000.0;
+        eprintln!(
+            "flux {flux:.3} vs π I₀ {exact:.3}: {:+.3}%",
+            100.0 * (flux / exact - 1.0)
+        );
         assert!((flux / exact - 1.0).abs() < 0.005, "{flux} vs {exact}");
     }
 

@@ -51,90 +51,75 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
             let (scene, options) = cli::solve_setup(&solve.scene, solve.epsilon, &solve.knobs)?;
             let vis = cli::backend_from(&solve.knobs).build(&scene)?;
-            if method == Method::Pathtrace {
-                let path_options = meshlight::reference::PathOptions {
-                    spp,
-                    seconds: time,
-                    seed: options.seed,
-                    threads: options.threads,
-                    ..Default::default()
-                };
-                let traced =
-                    cli::reference::path_trace_with_progress(&scene, vis.as_ref(), &path_options)?;
-                traced.image.write_exr(&output)?;
-                let png = output.with_extension("png");
-                traced.image.write_png(&png, traced.image.auto_exposure())?;
-                print!(
-                    "{}",
-                    cli::reference::path_summary(
+            // The image and what to say about how it was made, by each method.
+            let (image, summary) = match method {
+                Method::Pathtrace => {
+                    let path_options = meshlight::reference::PathOptions {
+                        spp,
+                        seconds: time,
+                        seed: options.seed,
+                        threads: options.threads,
+                        ..Default::default()
+                    };
+                    let traced = cli::reference::path_trace_with_progress(
+                        &scene,
+                        vis.as_ref(),
+                        &path_options,
+                    )?;
+                    let summary = cli::reference::path_summary(
                         &scene,
                         &traced,
                         &path_options,
                         &options,
-                        vis.name()
-                    )
-                );
-                println!(
-                    "total {:.2} s{}; wrote {} and {}",
-                    started.elapsed().as_secs_f64(),
-                    cli::memory::peak_bytes().map_or(String::new(), |b| format!(
-                        ", peak memory {}",
-                        cli::memory::human(b)
-                    )),
-                    output.display(),
-                    png.display()
-                );
-                return Ok(());
-            }
-            if method == Method::Patches {
-                let patch_options = meshlight::reference::PatchOptions {
-                    patch_size: match patch_size {
-                        Some(h) => h,
-                        None => meshlight::solver::choose_epsilon(&scene, &options)?.0,
-                    },
-                    supersample: supersample.max(1),
-                    tolerance: options.tolerance,
-                    max_shots: options.max_shots.unwrap_or(u64::MAX),
-                    seed: options.seed,
-                    threads: options.threads,
-                    ..Default::default()
-                };
-                let solved =
-                    cli::reference::patches_with_progress(&scene, vis.as_ref(), &patch_options)?;
-                solved.image.write_exr(&output)?;
-                let png = output.with_extension("png");
-                solved.image.write_png(&png, solved.image.auto_exposure())?;
-                print!(
-                    "{}",
-                    cli::reference::patch_summary(
+                        vis.name(),
+                    );
+                    (traced.image, summary)
+                }
+                Method::Patches => {
+                    let patch_options = meshlight::reference::PatchOptions {
+                        patch_size: match patch_size {
+                            Some(h) => h,
+                            None => meshlight::solver::choose_epsilon(&scene, &options)?.0,
+                        },
+                        supersample: supersample.max(1),
+                        tolerance: options.tolerance,
+                        max_shots: options.max_shots.unwrap_or(u64::MAX),
+                        seed: options.seed,
+                        threads: options.threads,
+                        ..Default::default()
+                    };
+                    let solved = cli::reference::patches_with_progress(
+                        &scene,
+                        vis.as_ref(),
+                        &patch_options,
+                    )?;
+                    let summary = cli::reference::patch_summary(
                         &scene,
                         &solved,
                         &patch_options,
                         &options,
-                        vis.name()
-                    )
-                );
-                println!(
-                    "total {:.2} s; wrote {} and {}",
-                    started.elapsed().as_secs_f64(),
-                    output.display(),
-                    png.display()
-                );
-                return Ok(());
-            }
-            let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
-            let render_options = meshlight::RenderOptions {
-                threads: options.threads,
-                supersample,
-                quantity: match false_color {
-                    Some(cli::FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
-                    _ => meshlight::Quantity::Radiance,
-                },
+                        vis.name(),
+                    );
+                    (solved.image, summary)
+                }
+                Method::Meshless => {
+                    let solution = cli::solve_with_progress(&scene, vis.as_ref(), &options)?;
+                    let render_options = meshlight::RenderOptions {
+                        threads: options.threads,
+                        supersample,
+                        quantity: match false_color {
+                            Some(cli::FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
+                            _ => meshlight::Quantity::Radiance,
+                        },
+                    };
+                    let t = std::time::Instant::now();
+                    let (image, stats) =
+                        meshlight::render(&scene, &solution, vis.as_ref(), &render_options)?;
+                    let summary = cli::solve_summary(&scene, &solution, &options, vis.name())
+                        + &cli::render_summary(&image, &stats, t.elapsed().as_secs_f64());
+                    (image, summary)
+                }
             };
-            let t = std::time::Instant::now();
-            let (image, stats) =
-                meshlight::render(&scene, &solution, vis.as_ref(), &render_options)?;
-            let render_seconds = t.elapsed().as_secs_f64();
             image.write_exr(&output)?;
             let png = output.with_extension("png");
             match false_color {
@@ -143,17 +128,13 @@ fn run(args: Args) -> anyhow::Result<()> {
                     cli::false_colour_render(&image, &png, kind, range, log, scene.units)?
                 }
             }
-            print!(
-                "{}",
-                cli::solve_summary(&scene, &solution, &options, vis.name())
-            );
-            print!("{}", cli::render_summary(&image, &stats, render_seconds));
+            print!("{summary}");
             println!(
                 "total {:.2} s{}; wrote {} and {}",
                 started.elapsed().as_secs_f64(),
                 cli::memory::peak_bytes().map_or(String::new(), |b| format!(
                     ", peak memory {}",
-                    cli::memory::human(b)
+                    meshlight::solver::human_bytes(b as f64)
                 )),
                 output.display(),
                 png.display()

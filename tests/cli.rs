@@ -248,12 +248,12 @@ fn compare_reports_bias_and_draws_the_signed_error() {
     // halfway up the red side (the light-red stop), the exact one is white.
     assert!(stdout.contains("saturate at ±50.000%"), "{stdout}");
     let picture = image::open(&png).unwrap().to_rgb8();
-    assert_eq!(picture.dimensions(), (2 + 170, 300));
+    assert_eq!(picture.dimensions(), (2 + 200, 320));
     assert_eq!(picture.get_pixel(0, 0).0, [244, 165, 130]);
     assert_eq!(picture.get_pixel(1, 0).0, [247, 247, 247]);
     // The legend has text: dark pixels right of the image, above the caption's end.
-    let dark = (2..172)
-        .flat_map(|x| (0..300).map(move |y| (x, y)))
+    let dark = (2..202)
+        .flat_map(|x| (0..320).map(move |y| (x, y)))
         .filter(|&(x, y)| picture.get_pixel(x, y).0.iter().all(|&c| c < 80))
         .count();
     assert!(dark > 200, "{dark} dark legend pixels");

@@ -121,6 +121,10 @@ fn the_flux_counts_in_the_emitted_power() {
     let power = scene.emitted_power();
     // The colour is normalised to luminance 1: the luminance of the power is the file's flux.
     let y = 0.2126 * power.x + 0.7152 * power.y + 0.0722 * power.z;
+    eprintln!(
+        "flux {y:.2} lm vs {flux:.2} lm by hand: {:+.3}%",
+        100.0 * (y / flux - 1.0)
+    );
     assert!((y / flux - 1.0).abs() < 0.005, "{y} lm vs {flux} lm");
     assert!(power.x > power.y && power.y > power.z);
 }

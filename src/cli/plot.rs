@@ -109,6 +109,88 @@ pub fn percent_label(fraction: f64) -> String {
     format!("{}%", text.trim_end_matches('0').trim_end_matches('.'))
 }
 
+/// The drawing area of a picture.
+type Root<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// What a false-colour picture's legend says.
+struct Legend<'a> {
+    title: String,
+    /// The colour at a height on the bar: 1 at the top, 0 at the bottom.
+    colour: &'a dyn Fn(f32) -> [u8; 3],
+    /// The values at 1, ¾, ½, ¼ and 0 of the bar, top down.
+    labels: [String; 5],
+    /// Lines under the bar.
+    caption: &'a [String],
+}
+
+/// Writes a picture of `width` × `height` that `paint` draws, with `legend` to its right.
+fn with_legend(
+    path: &Path,
+    (width, height): (u32, u32),
+    paint: impl FnOnce(&Root) -> Result<()>,
+    legend: &Legend,
+) -> Result<()> {
+    font()?;
+    let (w, h) = (width + 200, height.max(320));
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        paint(&root)?;
+        let style = ("sans-serif", 14).into_font();
+        let left = width as i32 + 14;
+        root.draw(&Text::new(legend.title.clone(), (left, 8), style.clone()))
+            .map_err(plot_error)?;
+        let (top, bar) = (34i32, 180i32);
+        for i in 0..bar {
+            let [r, g, b] = (legend.colour)(1.0 - i as f32 / (bar - 1) as f32);
+            root.draw(&Rectangle::new(
+                [(left, top + i), (left + 22, top + i + 1)],
+                RGBColor(r, g, b).filled(),
+            ))
+            .map_err(plot_error)?;
+        }
+        root.draw(&Rectangle::new(
+            [(left, top), (left + 22, top + bar)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(plot_error)?;
+        for (k, label) in legend.labels.iter().enumerate() {
+            let y = top + (bar - 1) * k as i32 / 4;
+            root.draw(&PathElement::new(
+                vec![(left + 22, y), (left + 27, y)],
+                BLACK,
+            ))
+            .map_err(plot_error)?;
+            root.draw(&Text::new(label.clone(), (left + 31, y - 7), style.clone()))
+                .map_err(plot_error)?;
+        }
+        for (i, line) in legend.caption.iter().enumerate() {
+            let y = top + bar + 16 + 18 * i as i32;
+            root.draw(&Text::new(line.clone(), (left, y), style.clone()))
+                .map_err(plot_error)?;
+        }
+        root.present().map_err(plot_error)?;
+    }
+    write_rgb(path, w, h, rgb)
+}
+
+/// Draws one pixel per value of a row-major `width`-wide image, coloured by `colour`.
+fn paint_pixels(
+    root: &Root,
+    width: u32,
+    values: &[f64],
+    colour: impl Fn(f64) -> [u8; 3],
+) -> Result<()> {
+    for (i, &v) in values.iter().enumerate() {
+        let [r, g, b] = colour(v);
+        let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
+        root.draw_pixel((x, y), &RGBColor(r, g, b))
+            .map_err(plot_error)?;
+    }
+    Ok(())
+}
+
 /// Writes a false-colour picture of signed per-pixel `values` (row-major, `width` × `height`)
 /// with a colour bar from −`range` to +`range` labelled in percent, a title over the bar and
 /// `caption` lines under it.
@@ -121,66 +203,15 @@ pub fn false_colour_png(
     title: &str,
     caption: &[String],
 ) -> Result<()> {
-    font()?;
-    let legend = 170u32;
-    let (w, h) = (width + legend, height.max(300));
-    let mut rgb = vec![0u8; w as usize * h as usize * 3];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        for y in 0..height {
-            for x in 0..width {
-                let v = values[y as usize * width as usize + x as usize];
-                let [r, g, b] = diverging((f64::from(v) / range) as f32);
-                root.draw_pixel((x as i32, y as i32), &RGBColor(r, g, b))
-                    .map_err(plot_error)?;
-            }
-        }
-        let style = ("sans-serif", 14).into_font();
-        let left = width as i32 + 14;
-        root.draw(&Text::new(title.to_string(), (left, 8), style.clone()))
-            .map_err(plot_error)?;
-        let (top, bar) = (34i32, 180i32);
-        for i in 0..bar {
-            let t = 1.0 - 2.0 * i as f32 / (bar - 1) as f32;
-            let [r, g, b] = diverging(t);
-            root.draw(&Rectangle::new(
-                [(left, top + i), (left + 22, top + i + 1)],
-                RGBColor(r, g, b).filled(),
-            ))
-            .map_err(plot_error)?;
-        }
-        root.draw(&Rectangle::new(
-            [(left, top), (left + 22, top + bar)],
-            BLACK.stroke_width(1),
-        ))
-        .map_err(plot_error)?;
-        for k in 0..5 {
-            let value = range * (1.0 - 0.5 * k as f64);
-            let y = top + (bar - 1) * k / 4;
-            root.draw(&PathElement::new(
-                vec![(left + 22, y), (left + 27, y)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(plot_error)?;
-            root.draw(&Text::new(
-                percent_label(value),
-                (left + 31, y - 7),
-                style.clone(),
-            ))
-            .map_err(plot_error)?;
-        }
-        for (i, line) in caption.iter().enumerate() {
-            root.draw(&Text::new(
-                line.clone(),
-                (left, top + bar + 16 + 18 * i as i32),
-                style.clone(),
-            ))
-            .map_err(plot_error)?;
-        }
-        root.present().map_err(plot_error)?;
-    }
-    write_rgb(path, w, h, rgb)
+    let values: Vec<f64> = values.iter().map(|&v| f64::from(v)).collect();
+    let paint = |root: &Root| paint_pixels(root, width, &values, |v| diverging((v / range) as f32));
+    let legend = Legend {
+        title: title.to_string(),
+        colour: &|f| diverging(2.0 * f - 1.0),
+        labels: [0, 1, 2, 3, 4].map(|k| percent_label(range * (1.0 - 0.5 * f64::from(k)))),
+        caption,
+    };
+    with_legend(path, (width, height), paint, &legend)
 }
 
 /// A sequential colour map for t in [0, 1] (dark blue, blue, green, yellow, red), as lighting
@@ -204,6 +235,19 @@ pub fn sequential(t: f32) -> [u8; 3] {
     [0, 1, 2].map(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0 + 0.5) as u8)
 }
 
+/// Labels of a legend from `high` (top) to `low`, linear or logarithmic, in `unit`.
+fn value_labels(low: f64, high: f64, log: bool, unit: &str) -> [String; 5] {
+    [0, 1, 2, 3, 4].map(|k| {
+        let t = 1.0 - f64::from(k) / 4.0;
+        let value = if log {
+            low * (high / low).powf(t)
+        } else {
+            low + (high - low) * t
+        };
+        format!("{value:.4} {unit}")
+    })
+}
+
 /// Writes a false-colour picture of per-pixel `values` (row-major, `width` × `height`) on the
 /// sequential map from `low` to `high` (logarithmic if `log`; then `low` must be > 0), with a
 /// colour bar labelled in `unit` and a title.
@@ -215,7 +259,6 @@ pub fn sequential_png(
     unit: &str,
     title: &str,
 ) -> Result<()> {
-    font()?;
     let level = |v: f64| -> f32 {
         let t = if log {
             (v.max(low) / low).ln() / (high / low).ln()
@@ -224,61 +267,19 @@ pub fn sequential_png(
         };
         t as f32
     };
-    let legend = 200u32;
-    let (w, h) = (width + legend, height.max(300));
-    let mut rgb = vec![0u8; w as usize * h as usize * 3];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        for y in 0..height {
-            for x in 0..width {
-                let [r, g, b] = sequential(level(values[(y * width + x) as usize]));
-                root.draw_pixel((x as i32, y as i32), &RGBColor(r, g, b))
-                    .map_err(plot_error)?;
-            }
-        }
-        let style = ("sans-serif", 14).into_font();
-        let left = width as i32 + 14;
-        root.draw(&Text::new(title.to_string(), (left, 8), style.clone()))
-            .map_err(plot_error)?;
-        let (top, bar) = (34i32, 180i32);
-        for i in 0..bar {
-            let [r, g, b] = sequential(1.0 - i as f32 / (bar - 1) as f32);
-            root.draw(&Rectangle::new(
-                [(left, top + i), (left + 22, top + i + 1)],
-                RGBColor(r, g, b).filled(),
-            ))
-            .map_err(plot_error)?;
-        }
-        for k in 0..5 {
-            let t = 1.0 - f64::from(k) / 4.0;
-            let value = if log {
-                low * (high / low).powf(t)
-            } else {
-                low + (high - low) * t
-            };
-            let y = top + (bar - 1) * k / 4;
-            root.draw(&PathElement::new(
-                vec![(left + 22, y), (left + 27, y)],
-                BLACK,
-            ))
-            .map_err(plot_error)?;
-            root.draw(&Text::new(
-                format!("{value:.4} {unit}"),
-                (left + 31, y - 7),
-                style.clone(),
-            ))
-            .map_err(plot_error)?;
-        }
-        root.present().map_err(plot_error)?;
-    }
-    write_rgb(path, w, h, rgb)
+    let paint = |root: &Root| paint_pixels(root, width, values, |v| sequential(level(v)));
+    let legend = Legend {
+        title: title.to_string(),
+        colour: &sequential,
+        labels: value_labels(low, high, log, unit),
+        caption: &[],
+    };
+    with_legend(path, (width, height), paint, &legend)
 }
 
 /// Writes a false-colour plan of a grid's values (`nu` × `nv`, row by row along u) from
 /// `low` to `high`, cells scaled to about 480 pixels along the longer side, with iso-lines at
-/// the legend's five values, a colour bar labelled in `unit`, a title and caption lines.
-#[allow(clippy::too_many_arguments)]
+/// the legend's three inner values, a colour bar labelled in `unit`, a title and caption lines.
 pub fn plan_png(
     path: &Path,
     (nu, nv): (u32, u32),
@@ -288,24 +289,19 @@ pub fn plan_png(
     title: &str,
     caption: &[String],
 ) -> Result<()> {
-    font()?;
     let cell = (480 / nu.max(nv)).clamp(1, 64);
-    let (width, height) = (nu * cell, nv * cell);
-    let legend = 190u32;
-    let (w, h) = (width + legend, height.max(320));
     let span = if high > low { high - low } else { 1.0 };
-    let level = |v: f64| ((v - low) / span) as f32;
-    let mut rgb = vec![0u8; w as usize * h as usize * 3];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        // Rows along v drawn from the bottom up, so the plan reads with v upwards.
+    let paint = |root: &Root| -> Result<()> {
+        let c = cell as i32;
+        // Row j along v drawn from the bottom up, so the plan reads with v upwards.
+        let corner = |i: u32, j: u32| ((i * cell) as i32, ((nv - 1 - j) * cell) as i32);
         for j in 0..nv {
             for i in 0..nu {
-                let [r, g, b] = sequential(level(values[(j * nu + i) as usize]));
-                let (x, y) = ((i * cell) as i32, ((nv - 1 - j) * cell) as i32);
+                let t = (values[(j * nu + i) as usize] - low) / span;
+                let [r, g, b] = sequential(t as f32);
+                let (x, y) = corner(i, j);
                 root.draw(&Rectangle::new(
-                    [(x, y), (x + cell as i32, y + cell as i32)],
+                    [(x, y), (x + c, y + c)],
                     RGBColor(r, g, b).filled(),
                 ))
                 .map_err(plot_error)?;
@@ -317,8 +313,7 @@ pub fn plan_png(
             let above = |i: u32, j: u32| values[(j * nu + i) as usize] >= iso;
             for j in 0..nv {
                 for i in 0..nu {
-                    let (x, y) = ((i * cell) as i32, ((nv - 1 - j) * cell) as i32);
-                    let c = cell as i32;
+                    let (x, y) = corner(i, j);
                     if i + 1 < nu && above(i, j) != above(i + 1, j) {
                         root.draw(&PathElement::new(vec![(x + c, y), (x + c, y + c)], BLACK))
                             .map_err(plot_error)?;
@@ -330,50 +325,15 @@ pub fn plan_png(
                 }
             }
         }
-        let style = ("sans-serif", 14).into_font();
-        let left = width as i32 + 14;
-        root.draw(&Text::new(title.to_string(), (left, 8), style.clone()))
-            .map_err(plot_error)?;
-        let (top, bar) = (34i32, 180i32);
-        for i in 0..bar {
-            let [r, g, b] = sequential(1.0 - i as f32 / (bar - 1) as f32);
-            root.draw(&Rectangle::new(
-                [(left, top + i), (left + 22, top + i + 1)],
-                RGBColor(r, g, b).filled(),
-            ))
-            .map_err(plot_error)?;
-        }
-        root.draw(&Rectangle::new(
-            [(left, top), (left + 22, top + bar)],
-            BLACK.stroke_width(1),
-        ))
-        .map_err(plot_error)?;
-        for k in 0..5 {
-            let value = high - span * f64::from(k) / 4.0;
-            let y = top + (bar - 1) * k / 4;
-            root.draw(&PathElement::new(
-                vec![(left + 22, y), (left + 27, y)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(plot_error)?;
-            root.draw(&Text::new(
-                format!("{value:.4} {unit}"),
-                (left + 31, y - 7),
-                style.clone(),
-            ))
-            .map_err(plot_error)?;
-        }
-        for (i, line) in caption.iter().enumerate() {
-            root.draw(&Text::new(
-                line.clone(),
-                (left, top + bar + 16 + 18 * i as i32),
-                style.clone(),
-            ))
-            .map_err(plot_error)?;
-        }
-        root.present().map_err(plot_error)?;
-    }
-    write_rgb(path, w, h, rgb)
+        Ok(())
+    };
+    let legend = Legend {
+        title: title.to_string(),
+        colour: &sequential,
+        labels: value_labels(low, low + span, false, unit),
+        caption,
+    };
+    with_legend(path, (nu * cell, nv * cell), paint, &legend)
 }
 
 /// Writes `image`'s signed error against `reference` as a false-colour picture; answers the

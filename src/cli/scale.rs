@@ -143,7 +143,12 @@ fn row(r: &Run) -> String {
     for t in &r.seconds {
         let _ = write!(s, " {t:>8.2}");
     }
-    let _ = write!(s, " {:>10}", r.peak.map_or("-".into(), memory::human));
+    let _ = write!(
+        s,
+        " {:>10}",
+        r.peak
+            .map_or("-".into(), |b| meshlight::solver::human_bytes(b as f64))
+    );
     s
 }
 

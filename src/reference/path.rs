@@ -168,93 +168,83 @@ pub fn path_trace(
     progress: &mut dyn FnMut(&PathProgress),
 ) -> Result<PathImage> {
     crate::parallel::guarded("the path tracer", || {
-        path_trace_unguarded(scene, vis, options, progress)
-    })
-}
-
-/// [`path_trace`] without its guard against panics.
-fn path_trace_unguarded(
-    scene: &Scene,
-    vis: &dyn Visibility,
-    options: &PathOptions,
-    progress: &mut dyn FnMut(&PathProgress),
-) -> Result<PathImage> {
-    if options.spp < 2 {
-        return Err(Error::Option {
-            option: "spp",
-            problem: format!(
-                "{} is fewer than 2 (one sample for each half-image)",
-                options.spp
-            ),
-        });
-    }
-    scene.camera.check()?;
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let pixels = w * h;
-    let lights = Lights::new(scene);
-    let lift = crate::visibility::lift(scene);
-    let threads = options.threads.max(1);
-    // Per pixel: sums of the even and of the odd samples.
-    let mut sums = vec![[DVec3::ZERO; 2]; pixels];
-    let mut rays = std::sync::atomic::AtomicU64::new(0);
-    let started = std::time::Instant::now();
-    // Passes of a few samples each: the time limit and progress act between them.
-    let pass = 2u32.max(options.spp / 32).min(options.spp);
-    let mut done = 0u32;
-    let points = scene.point_sources();
-    while done < options.spp {
-        let count = pass.min(options.spp - done);
-        let first = done;
-        let tracer = Tracer {
-            scene,
-            vis,
-            lights: &lights,
-            points: &points,
-            lift,
-            seed: options.seed,
-            max_bounces: options.max_bounces,
-        };
-        for_chunks(&mut sums, 64, threads, |start, chunk| {
-            let n = tracer.trace(start, chunk, first..first + count)?;
-            rays.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
-            Ok(())
-        })?;
-        done += count;
-        progress(&PathProgress {
-            done,
-            wanted: options.spp,
-        });
-        if options
-            .seconds
-            .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
-            && done % 2 == 0
-        {
-            break;
+        if options.spp < 2 {
+            return Err(Error::Option {
+                option: "spp",
+                problem: format!(
+                    "{} is fewer than 2 (one sample for each half-image)",
+                    options.spp
+                ),
+            });
         }
-    }
-    let image_of = |f: &dyn Fn(&[DVec3; 2]) -> DVec3| Image {
-        width: w as u32,
-        height: h as u32,
-        pixels: sums.iter().map(|s| f(s).as_vec3()).collect(),
-    };
-    let half = f64::from(done / 2);
-    let odd = f64::from(done - done / 2);
-    let image = image_of(&|s| (s[0] + s[1]) / f64::from(done));
-    let halves = [image_of(&|s| s[0] / half), image_of(&|s| s[1] / odd)];
-    let mean = image.mean();
-    let diff: f64 = halves[0]
-        .pixels
-        .iter()
-        .zip(&halves[1].pixels)
-        .map(|(a, b)| f64::from((*a - *b).abs().element_sum()))
-        .sum::<f64>()
-        / (3 * pixels.max(1)) as f64;
-    Ok(PathImage {
-        image,
-        halves,
-        spp: done,
-        noise: if mean > 0.0 { diff / 2.0 / mean } else { 0.0 },
-        rays: *rays.get_mut(),
+        scene.camera.check()?;
+        let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+        let pixels = w * h;
+        let lights = Lights::new(scene);
+        let lift = crate::visibility::lift(scene);
+        let threads = options.threads.max(1);
+        // Per pixel: sums of the even and of the odd samples.
+        let mut sums = vec![[DVec3::ZERO; 2]; pixels];
+        let mut rays = std::sync::atomic::AtomicU64::new(0);
+        let started = std::time::Instant::now();
+        // Passes of a few samples each: the time limit and progress act between them.
+        let pass = 2u32.max(options.spp / 32).min(options.spp);
+        let mut done = 0u32;
+        let points = scene.point_sources();
+        while done < options.spp {
+            let count = pass.min(options.spp - done);
+            let first = done;
+            let tracer = Tracer {
+                scene,
+                vis,
+                lights: &lights,
+                points: &points,
+                lift,
+                seed: options.seed,
+                max_bounces: options.max_bounces,
+            };
+            for_chunks(&mut sums, 64, threads, |start, chunk| {
+                let n = tracer.trace(start, chunk, first..first + count)?;
+                rays.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+                Ok(())
+            })?;
+            done += count;
+            progress(&PathProgress {
+                done,
+                wanted: options.spp,
+            });
+            if options
+                .seconds
+                .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
+                && done % 2 == 0
+            {
+                break;
+            }
+        }
+        let image_of = |f: &dyn Fn(&[DVec3; 2]) -> DVec3| Image {
+            width: w as u32,
+            height: h as u32,
+            pixels: sums.iter().map(|s| f(s).as_vec3()).collect(),
+        };
+        let half = f64::from(done / 2);
+        let odd = f64::from(done - done / 2);
+        let image = image_of(&|s| (s[0] + s[1]) / f64::from(done));
+        let halves = [image_of(&|s| s[0] / half), image_of(&|s| s[1] / odd)];
+        let mean = image.mean();
+        let diff: f64 = halves[0]
+            .pixels
+            .iter()
+            .zip(&halves[1].pixels)
+            .map(|(a, b)| f64::from((*a - *b).abs().element_sum()))
+            .sum::<f64>()
+            / (3 * pixels.max(1)) as f64;
+        Ok(PathImage {
+            image,
+            halves,
+            spp: done,
+            noise: if mean > 0.0 { diff / 2.0 / mean } else { 0.0 },
+            rays: *rays.get_mut(),
+        })
     })
 }
 

@@ -72,106 +72,96 @@ pub fn render(
     options: &RenderOptions,
 ) -> Result<(Image, RenderStats)> {
     crate::parallel::guarded("rendering", || {
-        render_unguarded(scene, solution, vis, options)
-    })
-}
+        let camera = &scene.camera;
+        camera.check()?;
+        solution.check_fits(scene)?;
+        let (w, h) = (camera.width as usize, camera.height as usize);
+        let shader = Shader::new(scene, solution, vis, options.quantity);
+        let mut stats = RenderStats::default();
 
-/// [`render`] without its guard against panics.
-fn render_unguarded(
-    scene: &Scene,
-    solution: &Solution,
-    vis: &dyn Visibility,
-    options: &RenderOptions,
-) -> Result<(Image, RenderStats)> {
-    let camera = &scene.camera;
-    camera.check()?;
-    solution.check_fits(scene)?;
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    let shader = Shader::new(scene, solution, vis, options.quantity);
-    let mut stats = RenderStats::default();
+        // Centre rays: radiance and the side each pixel sees.
+        let mut centre: Vec<(Vec3, u32)> = vec![(Vec3::ZERO, u32::MAX); w * h];
+        let queries = std::sync::atomic::AtomicU64::new(0);
+        for_chunks(&mut centre, w * 4, options.threads, |first, out| {
+            let rays: Vec<Ray> = (first..first + out.len())
+                .map(|p| camera_ray(scene, (p % w) as f32 + 0.5, (p / w) as f32 + 0.5))
+                .collect();
+            queries.fetch_add(
+                shader.shade(&rays, out)?,
+                std::sync::atomic::Ordering::Relaxed,
+            );
+            Ok(())
+        })?;
+        stats.camera_rays = (w * h) as u64;
 
-    // Centre rays: radiance and the side each pixel sees.
-    let mut centre: Vec<(Vec3, u32)> = vec![(Vec3::ZERO, u32::MAX); w * h];
-    let queries = std::sync::atomic::AtomicU64::new(0);
-    for_chunks(&mut centre, w * 4, options.threads, |first, out| {
-        let rays: Vec<Ray> = (first..first + out.len())
-            .map(|p| camera_ray(scene, (p % w) as f32 + 0.5, (p / w) as f32 + 0.5))
-            .collect();
-        queries.fetch_add(
-            shader.shade(&rays, out)?,
-            std::sync::atomic::Ordering::Relaxed,
-        );
-        Ok(())
-    })?;
-    stats.camera_rays = (w * h) as u64;
-
-    // Edge pixels: a neighbour sees another side.
-    let n = options.supersample.max(1) as usize;
-    let edges: Vec<usize> = if n > 1 {
-        (0..w * h)
-            .filter(|&p| {
-                let (x, y) = (p % w, p / w);
-                let side = centre[p].1;
-                (x > 0 && centre[p - 1].1 != side)
-                    || (x + 1 < w && centre[p + 1].1 != side)
-                    || (y > 0 && centre[p - w].1 != side)
-                    || (y + 1 < h && centre[p + w].1 != side)
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let mut refined = vec![Vec3::ZERO; edges.len()];
-    for_chunks(&mut refined, 64, options.threads, |first, out| {
-        let mut rays = Vec::with_capacity(out.len() * n * n);
-        for &p in &edges[first..first + out.len()] {
-            let (x, y) = ((p % w) as f32, (p / w) as f32);
-            // Stratified and jittered: a regular grid measures a straight edge's coverage in
-            // steps of 1/n with the same error all along the edge, which biased the mean of a
-            // small image by the bright edge pixels of a light.
-            let mut h = p as u64 ^ 0x5851_f42d_4c95_7f2d;
-            let mut jitter = || {
-                h = h
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                ((h >> 40) as f32) / (1u64 << 24) as f32
-            };
-            for j in 0..n {
-                for i in 0..n {
-                    let (dx, dy) = (
-                        (i as f32 + jitter()) / n as f32,
-                        (j as f32 + jitter()) / n as f32,
-                    );
-                    rays.push(camera_ray(scene, x + dx, y + dy));
+        // Edge pixels: a neighbour sees another side.
+        let n = options.supersample.max(1) as usize;
+        let edges: Vec<usize> = if n > 1 {
+            (0..w * h)
+                .filter(|&p| {
+                    let (x, y) = (p % w, p / w);
+                    let side = centre[p].1;
+                    (x > 0 && centre[p - 1].1 != side)
+                        || (x + 1 < w && centre[p + 1].1 != side)
+                        || (y > 0 && centre[p - w].1 != side)
+                        || (y + 1 < h && centre[p + w].1 != side)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut refined = vec![Vec3::ZERO; edges.len()];
+        for_chunks(&mut refined, 64, options.threads, |first, out| {
+            let mut rays = Vec::with_capacity(out.len() * n * n);
+            for &p in &edges[first..first + out.len()] {
+                let (x, y) = ((p % w) as f32, (p / w) as f32);
+                // Stratified and jittered: a regular grid measures a straight edge's coverage in
+                // steps of 1/n with the same error all along the edge, which biased the mean of a
+                // small image by the bright edge pixels of a light.
+                let mut h = p as u64 ^ 0x5851_f42d_4c95_7f2d;
+                let mut jitter = || {
+                    h = h
+                        .wrapping_mul(6_364_136_223_846_793_005)
+                        .wrapping_add(1_442_695_040_888_963_407);
+                    ((h >> 40) as f32) / (1u64 << 24) as f32
+                };
+                for j in 0..n {
+                    for i in 0..n {
+                        let (dx, dy) = (
+                            (i as f32 + jitter()) / n as f32,
+                            (j as f32 + jitter()) / n as f32,
+                        );
+                        rays.push(camera_ray(scene, x + dx, y + dy));
+                    }
                 }
             }
-        }
-        let mut shaded = vec![(Vec3::ZERO, 0u32); rays.len()];
-        queries.fetch_add(
-            shader.shade(&rays, &mut shaded)?,
-            std::sync::atomic::Ordering::Relaxed,
-        );
-        for (o, group) in out.iter_mut().zip(shaded.chunks(n * n)) {
-            *o = group.iter().map(|s| s.0).sum::<Vec3>() / (n * n) as f32;
-        }
-        Ok(())
-    })?;
-    stats.camera_rays += (edges.len() * n * n) as u64;
-    stats.supersampled_pixels = edges.len() as u64;
-    stats.interpolation_queries = queries.into_inner();
+            let mut shaded = vec![(Vec3::ZERO, 0u32); rays.len()];
+            queries.fetch_add(
+                shader.shade(&rays, &mut shaded)?,
+                std::sync::atomic::Ordering::Relaxed,
+            );
+            for (o, group) in out.iter_mut().zip(shaded.chunks(n * n)) {
+                *o = group.iter().map(|s| s.0).sum::<Vec3>() / (n * n) as f32;
+            }
+            Ok(())
+        })?;
+        stats.camera_rays += (edges.len() * n * n) as u64;
+        stats.supersampled_pixels = edges.len() as u64;
+        stats.interpolation_queries = queries.into_inner();
 
-    let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
-    for (&p, &value) in edges.iter().zip(&refined) {
-        pixels[p] = value;
-    }
-    Ok((
-        Image {
-            width: camera.width,
-            height: camera.height,
-            pixels,
-        },
-        stats,
-    ))
+        let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
+        for (&p, &value) in edges.iter().zip(&refined) {
+            pixels[p] = value;
+        }
+        Ok((
+            Image {
+                width: camera.width,
+                height: camera.height,
+                pixels,
+            },
+            stats,
+        ))
+    })
 }
 
 fn camera_ray(scene: &Scene, x: f32, y: f32) -> Ray {
@@ -246,28 +236,31 @@ impl<'a> Shader<'a> {
     fn shade(&self, rays: &[Ray], out: &mut [(Vec3, u32)]) -> Result<u64> {
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(rays, &mut hits)?;
-        // Whether each hit is covered, asked in one batch.
-        let covers: Vec<Segment> = rays
+        // Whether each hit that will be interpolated is covered, asked in one batch (hits on
+        // emitters and sides without samples show a fixed value and need not ask).
+        let interpolated: Vec<Option<(Vec3, Vec3)>> = rays
             .iter()
             .zip(&hits)
-            .filter_map(|(ray, hit)| {
+            .map(|(ray, hit)| {
                 let Hit { t, triangle } = (*hit)?;
                 let tri = &self.scene.triangles[triangle as usize];
                 let back = ray.dir.dot(tri.normal) > 0.0;
+                if self.support[side_of(tri.surface, back) as usize] <= 0.0 {
+                    return None;
+                }
                 let normal = if back { -tri.normal } else { tri.normal };
-                let point = ray.origin + t * ray.dir;
-                Some(cover::segment(
-                    point,
-                    normal,
-                    self.lift,
-                    self.solution.epsilon,
-                ))
+                Some((ray.origin + t * ray.dir, normal))
             })
+            .collect();
+        let covers: Vec<Segment> = interpolated
+            .iter()
+            .flatten()
+            .map(|&(p, n)| cover::segment(p, n, self.lift, self.solution.epsilon))
             .collect();
         let mut answers = vec![false; covers.len()];
         self.vis.occluded(&covers, &mut answers)?;
         let mut answer = answers.into_iter();
-        let covered: Vec<bool> = hits
+        let covered: Vec<bool> = interpolated
             .iter()
             .map(|h| h.is_some() && answer.next().unwrap_or(false))
             .collect();

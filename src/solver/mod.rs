@@ -365,34 +365,23 @@ pub fn transfer(
     source: DVec3,
 ) -> Result<Vec<DVec3>> {
     crate::parallel::guarded("the transfer", || {
-        transfer_unguarded(scene, solution, vis, shooters, source)
-    })
-}
-
-/// [`transfer`] without its guard against panics.
-fn transfer_unguarded(
-    scene: &Scene,
-    solution: &Solution,
-    vis: &dyn Visibility,
-    shooters: &[u32],
-    source: DVec3,
-) -> Result<Vec<DVec3>> {
-    solution.check_fits(scene)?;
-    let (samples, maps) = (&solution.samples, &solution.maps);
-    if let Some(&j) = shooters.iter().find(|&&j| j as usize >= samples.len()) {
-        return Err(Error::argument(
-            "shooters",
-            format!("sample {j} does not exist ({} samples)", samples.len()),
-        ));
-    }
-    let lift = crate::visibility::lift(scene);
-    let mut irradiance = vec![DVec3::ZERO; samples.len()];
-    for &j in shooters {
-        for (i, f) in flat::form_factors(samples, maps, vis, lift, j as usize)? {
-            irradiance[i as usize] += source * f64::from(f);
+        solution.check_fits(scene)?;
+        let (samples, maps) = (&solution.samples, &solution.maps);
+        if let Some(&j) = shooters.iter().find(|&&j| j as usize >= samples.len()) {
+            return Err(Error::argument(
+                "shooters",
+                format!("sample {j} does not exist ({} samples)", samples.len()),
+            ));
         }
-    }
-    Ok(irradiance)
+        let lift = crate::visibility::lift(scene);
+        let mut irradiance = vec![DVec3::ZERO; samples.len()];
+        for &j in shooters {
+            for (i, f) in flat::form_factors(samples, maps, vis, lift, j as usize)? {
+                irradiance[i as usize] += source * f64::from(f);
+            }
+        }
+        Ok(irradiance)
+    })
 }
 
 /// Bytes in binary units, for messages: "3.2 GiB".

@@ -40,9 +40,9 @@ pub struct Options {
     /// partly visible link whose whole transfer is below a quarter of the error threshold
     /// carries the visible share its probes measured (no wall is ever crossed: clusters never
     /// straddle an occluder). Exact visibility sharpens faint penumbrae at a cost that grows
-    /// faster than the samples: on the shipped gallery 3.9 s instead of 2.9 s, and a
-    /// 99th-percentile pixel error against the flat solve of 1.4% instead of 4.7%; at 179k
-    /// samples 91 M links and 2.4 GB instead of 4.4 M and 0.7 GB.
+    /// faster than the samples: on the shipped gallery 3.7 s instead of 3.1 s for about the
+    /// same error against the flat solve (MAE/mean 0.22% and 0.21%); at 179k samples 98 M
+    /// links and 2.6 GB instead of 5.1 M and 0.7 GB (README).
     pub exact_visibility: bool,
     /// The memory budget, bytes: every large structure counts against it. The samples and
     /// their results are predicted before they are placed ([`BYTES_PER_SAMPLE`] each) and a

@@ -91,127 +91,118 @@ pub fn patch_radiosity(
     progress: &mut dyn FnMut(PatchProgress) -> Control,
 ) -> Result<PatchImage> {
     crate::parallel::guarded("the patch solver", || {
-        patch_radiosity_unguarded(scene, vis, options, progress)
-    })
-}
-
-/// [`patch_radiosity`] without its guard against panics.
-fn patch_radiosity_unguarded(
-    scene: &Scene,
-    vis: &dyn Visibility,
-    options: &PatchOptions,
-    progress: &mut dyn FnMut(PatchProgress) -> Control,
-) -> Result<PatchImage> {
-    let size = options.patch_size;
-    if !(size.is_finite() && size > 0.0) {
-        return Err(Error::Option {
-            option: "patch-size",
-            problem: format!("must be a positive length, not {size}"),
-        });
-    }
-    if !(options.tolerance.is_finite() && options.tolerance > 0.0 && options.tolerance < 1.0) {
-        return Err(Error::Option {
-            option: "tolerance",
-            problem: format!("must lie in (0, 1), not {}", options.tolerance),
-        });
-    }
-    scene.camera.check()?;
-    if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
-        return Err(Error::Option {
-            option: "supersample",
-            problem: format!(
-                "{} rays per side of a pixel: it must lie in 1..={MAX_SUPERSAMPLE}",
-                options.supersample
-            ),
-        });
-    }
-    // The grids span each surface's bounding box in its plane: a thin diagonal strip or a
-    // ring holds far more cells than its area says. Bound them before allocating.
-    let cells = mesh::grid_cells(scene, size);
-    let cell_limit = 16.0 * options.max_patches as f64;
-    if cells > cell_limit {
-        return Err(Error::Option {
-            option: "patch-size",
-            problem: format!(
-                "{size} lays grids of {cells:.0} cells over the surfaces' bounding boxes, more \
-                 than the {cell_limit:.0} allowed (16 × the patch limit): choose a larger size"
-            ),
-        });
-    }
-    let estimate = mesh::estimate(scene, size);
-    if estimate > options.max_patches as f64 {
-        return Err(Error::Option {
-            option: "patch-size",
-            problem: format!(
-                "{size} cuts the scene's {:.1} area units into about {estimate:.0} patches, more \
-                 than the {} allowed (the solve grows as the square): choose a larger size",
-                scene.total_area(),
-                options.max_patches
-            ),
-        });
-    }
-    let t = std::time::Instant::now();
-    let mesh = mesh::mesh(scene, size);
-    if mesh.patches.len() > options.max_patches {
-        return Err(Error::Option {
-            option: "patch-size",
-            problem: format!(
-                "{size} cuts the surfaces into {} patches (slivers of cells count too), more \
-                 than the {} allowed: choose a larger size",
-                mesh.patches.len(),
-                options.max_patches
-            ),
-        });
-    }
-    let meshing = t.elapsed().as_secs_f64();
-    let t = std::time::Instant::now();
-    let lift = crate::visibility::lift(scene);
-    let mut state: Vec<solve::PatchState> = mesh
-        .patches
-        .iter()
-        .map(|p| solve::PatchState {
-            radiosity: p.emitted,
-            unshot: p.emitted,
-        })
-        .collect();
-    let direct = solve::point_lights(scene, &mesh.patches, &mut state, vis, lift, options.threads)?;
-    let patches = mesh.patches.len();
-    let shooting = solve::shoot(
-        &mesh.patches,
-        state,
-        vis,
-        lift,
-        options.threads,
-        options.tolerance,
-        options.max_shots,
-        &mut |shots, unshot_fraction| {
-            progress(PatchProgress {
-                patches,
-                shots,
-                unshot_fraction,
-                tolerance: options.tolerance,
+        let size = options.patch_size;
+        if !(size.is_finite() && size > 0.0) {
+            return Err(Error::Option {
+                option: "patch-size",
+                problem: format!("must be a positive length, not {size}"),
+            });
+        }
+        if !(options.tolerance.is_finite() && options.tolerance > 0.0 && options.tolerance < 1.0) {
+            return Err(Error::Option {
+                option: "tolerance",
+                problem: format!("must lie in (0, 1), not {}", options.tolerance),
+            });
+        }
+        scene.camera.check()?;
+        if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
+            return Err(Error::Option {
+                option: "supersample",
+                problem: format!(
+                    "{} rays per side of a pixel: it must lie in 1..={MAX_SUPERSAMPLE}",
+                    options.supersample
+                ),
+            });
+        }
+        // The grids span each surface's bounding box in its plane: a thin diagonal strip or a
+        // ring holds far more cells than its area says. Bound them before allocating.
+        let cells = mesh::grid_cells(scene, size);
+        let cell_limit = 16.0 * options.max_patches as f64;
+        if cells > cell_limit {
+            return Err(Error::Option {
+                option: "patch-size",
+                problem: format!(
+                    "{size} lays grids of {cells:.0} cells over the surfaces' bounding boxes, more \
+                     than the {cell_limit:.0} allowed (16 × the patch limit): choose a larger size"
+                ),
+            });
+        }
+        let estimate = mesh::estimate(scene, size);
+        if estimate > options.max_patches as f64 {
+            return Err(Error::Option {
+                option: "patch-size",
+                problem: format!(
+                    "{size} cuts the scene's {:.1} area units into about {estimate:.0} patches, more \
+                     than the {} allowed (the solve grows as the square): choose a larger size",
+                    scene.total_area(),
+                    options.max_patches
+                ),
+            });
+        }
+        let t = std::time::Instant::now();
+        let mesh = mesh::mesh(scene, size);
+        if mesh.patches.len() > options.max_patches {
+            return Err(Error::Option {
+                option: "patch-size",
+                problem: format!(
+                    "{size} cuts the surfaces into {} patches (slivers of cells count too), more \
+                     than the {} allowed: choose a larger size",
+                    mesh.patches.len(),
+                    options.max_patches
+                ),
+            });
+        }
+        let meshing = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let lift = crate::visibility::lift(scene);
+        let mut state: Vec<solve::PatchState> = mesh
+            .patches
+            .iter()
+            .map(|p| solve::PatchState {
+                radiosity: p.emitted,
+                unshot: p.emitted,
             })
-        },
-    )?;
-    let solving = t.elapsed().as_secs_f64();
-    let t = std::time::Instant::now();
-    let radiosity: Vec<_> = shooting.state.iter().map(|s| s.radiosity).collect();
-    let image = render::render(
-        scene,
-        &mesh,
-        &radiosity,
-        vis,
-        options.supersample,
-        options.seed,
-        options.threads,
-    )?;
-    Ok(PatchImage {
-        image,
-        patches,
-        shots: shooting.shots,
-        queries: direct + shooting.queries,
-        unshot_fraction: shooting.unshot_fraction,
-        stopped: shooting.stopped,
-        seconds: [meshing, solving, t.elapsed().as_secs_f64()],
+            .collect();
+        let direct =
+            solve::point_lights(scene, &mesh.patches, &mut state, vis, lift, options.threads)?;
+        let patches = mesh.patches.len();
+        let shooting = solve::shoot(
+            &mesh.patches,
+            state,
+            vis,
+            lift,
+            options.threads,
+            options.tolerance,
+            options.max_shots,
+            &mut |shots, unshot_fraction| {
+                progress(PatchProgress {
+                    patches,
+                    shots,
+                    unshot_fraction,
+                    tolerance: options.tolerance,
+                })
+            },
+        )?;
+        let solving = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let radiosity: Vec<_> = shooting.state.iter().map(|s| s.radiosity).collect();
+        let image = render::render(
+            scene,
+            &mesh,
+            &radiosity,
+            vis,
+            options.supersample,
+            options.seed,
+            options.threads,
+        )?;
+        Ok(PatchImage {
+            image,
+            patches,
+            shots: shooting.shots,
+            queries: direct + shooting.queries,
+            unshot_fraction: shooting.unshot_fraction,
+            stopped: shooting.stopped,
+            seconds: [meshing, solving, t.elapsed().as_secs_f64()],
+        })
     })
 }
