@@ -21,7 +21,15 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// Over `values`; all zero when there are none (every point inside a solid).
     fn of(values: &[f64]) -> Summary {
+        if values.is_empty() {
+            return Summary {
+                min: 0.0,
+                avg: 0.0,
+                max: 0.0,
+            };
+        }
         let min = values.iter().copied().fold(f64::INFINITY, f64::min);
         let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let avg = values.iter().sum::<f64>() / values.len().max(1) as f64;
@@ -136,4 +144,22 @@ pub fn run(
         println!("wrote {} and {}", csv.display(), png.display());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Summary;
+
+    #[test]
+    fn summaries_by_hand_and_of_nothing() {
+        let s = Summary::of(&[1.0, 2.0, 3.0]);
+        assert_eq!((s.min, s.avg, s.max), (1.0, 2.0, 3.0));
+        assert_eq!((s.uniformity(), s.diversity()), (0.5, 1.0 / 3.0));
+        // Every point inside a solid: zeros, not infinities.
+        let none = Summary::of(&[]);
+        assert_eq!(
+            (none.min, none.avg, none.max, none.uniformity()),
+            (0.0, 0.0, 0.0, 0.0)
+        );
+    }
 }
