@@ -1,6 +1,6 @@
 #!/bin/bash
 # Re-measures docs/accuracy.md: path-traced references, the bias table, the knob table and the
-# sweeps. Takes about 45 minutes on 2 cores (the references are most of it).
+# sweeps. Takes about 45 minutes on 2 cores, the references most of it (OUT_DIR keeps them).
 # Usage: docs/accuracy.sh OUT_DIR [OLD_BINARY]   (OLD_BINARY: a build of ba22335 for "before")
 set -euo pipefail
 OUT=${1:?usage: docs/accuracy.sh OUT_DIR [OLD_BINARY]}
@@ -28,8 +28,8 @@ mkdir -p gallery && cp "$ROOT/scenes/gallery/scene.toml" gallery/
 ln -sf "$ROOT/scenes/gallery/gallery.obj" "$ROOT/scenes/gallery/gallery.mtl" gallery/
 sed -i "s/^width = .*/width = 192/; s/^height = .*/height = 128/" gallery/scene.toml
 
-# References.
-ref() { "$M" render "$1/scene.toml" --method pathtrace --spp "$2" -o "ref_$1.exr" > "ref_$1.log" 2>/dev/null; }
+# References (kept when OUT_DIR already holds them: they do not depend on the solver).
+ref() { [ -f "ref_$1.exr" ] && return; "$M" render "$1/scene.toml" --method pathtrace --spp "$2" -o "ref_$1.exr" > "ref_$1.log" 2>/dev/null; }
 ref room 8192; ref room85 2048; ref room95 4096; ref room95s 40000
 ref cornell 1024; ref cornell95 1024; ref gallery 16384
 
@@ -46,7 +46,8 @@ done
 
 # Each knob alone from the defaults, on room.
 for k in "epsilon=0.4,0.18" "zeta=0.1,0.4" "rounds=0,1" "alpha=0,2,32" "light-samples=4,64" \
-         "tolerance=1e-2,1e-4" "seed=1" "cluster-threshold=0,0.01,0.2,1"; do
+         "tolerance=1e-2,1e-4" "seed=1" "cluster-threshold=0,0.01,0.2,1" "direct-rays=0,4,64" \
+         "supersample=1,8"; do
   "$M" sweep room/scene.toml --reference ref_room.exr --vary "$k" --no-pathtrace --out "knob_${k%%=*}" > "knob_${k%%=*}.txt" 2>/dev/null
 done
 

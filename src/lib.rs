@@ -40,7 +40,7 @@ pub mod solver;
 pub mod visibility;
 
 pub use error::{Error, Result};
-pub use render::{render, Image, Quantity, RenderOptions};
+pub use render::{render, Direct, Image, Quantity, RenderOptions};
 pub use scene::Scene;
 pub use solver::{solve, Options, Solution};
 pub use visibility::{Backend, Visibility};

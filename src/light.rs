@@ -18,6 +18,9 @@ use crate::sampling::poisson::side_seed;
 use crate::scene::{PointSource, Scene};
 use crate::visibility::{Segment, Visibility};
 
+/// The golden ratio's fractional part: the Fibonacci lattice's second coordinate.
+const GOLDEN: f64 = 0.618_033_988_749_894_8;
+
 /// An area light: one emitting surface.
 struct Emitter {
     triangles: Vec<[Vec3; 3]>,
@@ -135,7 +138,7 @@ impl DirectLight {
     }
 
     /// One batch: the shadow rays of its receivers, one visibility call per kind of light.
-    fn batch(
+    pub(crate) fn batch(
         &self,
         vis: &dyn Visibility,
         points: &[(Vec3, Vec3)],
@@ -254,15 +257,27 @@ impl DirectLight {
                 unoccluded[r] += (emitter.ke * irradiance).element_sum();
                 let total = *emitter.cumulative.last().unwrap_or(&0.0);
                 let count = self.light_samples;
+                // A Fibonacci lattice over the emitter, shifted at random per receiver (Cranley
+                // and Patterson): as even in two dimensions as a grid for any count, and unbiased.
+                let shift = (rng.random::<f64>(), rng.random::<f64>());
                 for s in 0..count {
-                    // Stratified along the emitter's cumulative area, jittered inside each stratum.
-                    let u = (f64::from(s) + rng.random::<f64>()) / f64::from(count) * total;
+                    let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
+                    let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
+                    // The first coordinate runs along the emitter's cumulative area: it picks the
+                    // triangle, and what is left of it places the point inside.
+                    let u = u1 * total;
                     let t = emitter
                         .cumulative
                         .partition_point(|&c| c <= u)
                         .min(emitter.triangles.len() - 1);
+                    let start = if t == 0 {
+                        0.0
+                    } else {
+                        emitter.cumulative[t - 1]
+                    };
+                    let within = ((u - start) / (emitter.cumulative[t] - start)).clamp(0.0, 1.0);
                     let [a, b, c] = emitter.triangles[t];
-                    let (r1, r2) = (rng.random::<f32>().sqrt(), rng.random::<f32>());
+                    let (r1, r2) = (within.sqrt() as f32, u2 as f32);
                     let y = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
                     let d = y - x;
                     let dist2 = d.length_squared();

@@ -37,6 +37,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             solve,
             output,
             supersample,
+            direct_rays,
             method,
             spp,
             time,
@@ -107,6 +108,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                     let render_options = meshlight::RenderOptions {
                         threads: options.threads,
                         supersample,
+                        direct: meshlight::Direct::from_rays(direct_rays),
                         quantity: match false_color {
                             Some(cli::FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
                             _ => meshlight::Quantity::Radiance,
@@ -178,6 +180,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             vary,
             method,
             supersample,
+            direct_rays,
             patch_size,
             spp,
             out,
@@ -197,6 +200,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                     epsilon: solve.epsilon,
                     knobs: solve.knobs,
                     supersample,
+                    direct_rays,
                     patch_size,
                     spp,
                     out,

@@ -3,6 +3,7 @@
 mod common;
 
 use common::{backends, shipped, two_rooms};
+use glam::Vec3;
 use meshlight::solver::Options;
 use meshlight::{Image, Scene};
 
@@ -100,4 +101,179 @@ fn the_image_is_upright_and_not_mirrored() {
         "the light shows at row {} of {h}",
         brightest / w
     );
+}
+
+/// Form factor from a point to a parallel rectangle [0, a] × [0, b] with a corner straight
+/// above it at height h (the textbook closed form).
+fn corner_rectangle(a: f64, b: f64, h: f64) -> f64 {
+    let (x, y) = (a / h, b / h);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+}
+
+/// Form factor from (px, pz) on the floor to the parallel rectangle [x0, x1] × [z0, z1] at
+/// height h: four corner rectangles, signed.
+fn rectangle_above(px: f64, pz: f64, (x0, x1, z0, z1): (f64, f64, f64, f64), h: f64) -> f64 {
+    let part = |x: f64, z: f64| {
+        let (dx, dz) = (x - px, z - pz);
+        dx.signum() * dz.signum() * corner_rectangle(dx.abs(), dz.abs(), h)
+    };
+    part(x1, z1) - part(x0, z1) - part(x1, z0) + part(x0, z0)
+}
+
+/// A floor 8 m square under a camera 1 m up looking straight down, lit by `light`.
+fn floor_under(light: impl FnOnce(&mut common::Builder)) -> Scene {
+    let mut b = common::Builder::default();
+    let grey = b.material(common::material("grey", 0.5, 0.0));
+    b.quad(
+        [
+            Vec3::new(-4.0, 0.0, -4.0),
+            Vec3::new(-4.0, 0.0, 4.0),
+            Vec3::new(4.0, 0.0, 4.0),
+            Vec3::new(4.0, 0.0, -4.0),
+        ],
+        grey,
+    );
+    light(&mut b);
+    let mut camera = common::camera(Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO, 24);
+    camera.up = Vec3::Z;
+    b.scene(camera)
+}
+
+/// Where pixel (x, y)'s centre ray meets the floor y = 0.
+fn floor_hit(scene: &Scene, x: usize, y: usize) -> Vec3 {
+    let c = &scene.camera;
+    let d = c.direction(x as f32 + 0.5, y as f32 + 0.5);
+    c.position + d * (-c.position.y / d.y)
+}
+
+/// Irradiance images of a floor whose direct light has a closed form: traced at every pixel
+/// it matches to float precision; interpolated from the samples it does not.
+fn assert_direct_light_is_exact(scene: &Scene, exact: impl Fn(Vec3) -> f64) {
+    for backend in backends() {
+        let vis = backend.build(scene).unwrap();
+        let solution = common::solve(scene, backend, Options::default());
+        let mut worst = [0.0f64; 2];
+        for (slot, direct) in [
+            meshlight::Direct::Traced { light_samples: 4 },
+            meshlight::Direct::Interpolated,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let options = meshlight::RenderOptions {
+                quantity: meshlight::Quantity::Irradiance,
+                supersample: 1,
+                direct,
+                ..meshlight::RenderOptions::default()
+            };
+            let (image, _) = meshlight::render(scene, &solution, vis.as_ref(), &options).unwrap();
+            let w = image.width as usize;
+            for (i, p) in image.pixels.iter().enumerate() {
+                let e = exact(floor_hit(scene, i % w, i / w));
+                worst[slot] = worst[slot].max((f64::from(p.x) / e - 1.0).abs());
+            }
+        }
+        // The floor sees nothing but the light: all its irradiance is direct.
+        assert!(worst[0] < 1e-4, "{backend}: traced, worst {}", worst[0]);
+        assert!(
+            worst[1] > 1e-3,
+            "{backend}: interpolated, worst {}: the test cannot tell",
+            worst[1]
+        );
+    }
+}
+
+#[test]
+fn direct_light_traced_at_each_pixel_follows_the_inverse_square_law() {
+    let scene = floor_under(|b| {
+        b.point_lights.push(meshlight::scene::PointLight {
+            position: Vec3::new(0.3, 1.0, -0.2),
+            intensity: Vec3::splat(10.0),
+        })
+    });
+    // E = I cosθ / r² = I h / r³.
+    assert_direct_light_is_exact(&scene, |p| {
+        let r = (Vec3::new(0.3, 1.0, -0.2) - p).length() as f64;
+        10.0 / (r * r * r)
+    });
+}
+
+#[test]
+fn direct_light_traced_at_each_pixel_matches_the_rectangle_form_factor() {
+    // A 1 × 0.6 m panel of radiance 5 at height 1.2 facing down: E = π L F.
+    let scene = floor_under(|b| {
+        let lamp = b.material(common::material("lamp", 0.0, 5.0));
+        b.quad(
+            [
+                Vec3::new(-0.4, 1.2, -0.3),
+                Vec3::new(0.6, 1.2, -0.3),
+                Vec3::new(0.6, 1.2, 0.3),
+                Vec3::new(-0.4, 1.2, 0.3),
+            ],
+            lamp,
+        );
+    });
+    assert_direct_light_is_exact(&scene, |p| {
+        let f = rectangle_above(f64::from(p.x), f64::from(p.z), (-0.4, 0.6, -0.3, 0.3), 1.2);
+        std::f64::consts::PI * 5.0 * f
+    });
+}
+
+#[test]
+fn the_rim_of_a_bright_light_is_covered_to_its_area() {
+    // A square of radiance 50 facing the camera before an unlit wall, an eighth of the image
+    // wide: each pixel shows 50 × the share of it the square covers (the square's edges run
+    // along the pixels'). An n × n jittered grid errs by at most one row of strata on such an
+    // edge, 1/n of the pixel; the contrast (64× the image's mean) calls for 16 × 16 rays.
+    let mut b = common::Builder::default();
+    let dark = b.material(common::material("dark", 0.2, 0.0));
+    let lamp = b.material(common::material("lamp", 0.0, 50.0));
+    b.quad(
+        [
+            Vec3::new(-9.0, -9.0, 5.0),
+            Vec3::new(-9.0, 9.0, 5.0),
+            Vec3::new(9.0, 9.0, 5.0),
+            Vec3::new(9.0, -9.0, 5.0),
+        ],
+        dark,
+    );
+    let camera = common::camera(Vec3::ZERO, Vec3::Z, 64);
+    // Half-width of the view at distance 4 is 4 tan 30°; the square spans an eighth of it
+    // each side of the centre, off the pixel grid by a third of a pixel.
+    let half_view = 4.0 * (30.0f32).to_radians().tan();
+    let (lo, hi) = (
+        -half_view / 8.0 + half_view / 96.0,
+        half_view / 8.0 + half_view / 96.0,
+    );
+    b.quad(
+        [
+            Vec3::new(lo, lo, 4.0),
+            Vec3::new(lo, hi, 4.0),
+            Vec3::new(hi, hi, 4.0),
+            Vec3::new(hi, lo, 4.0),
+        ],
+        lamp,
+    );
+    let scene = b.scene(camera);
+    // The square in pixels: x grows to the camera's right (−x in the scene), y downwards.
+    let to_px = |v: f32| 32.0 + v / half_view * 32.0;
+    let (x0, x1) = (to_px(-hi), to_px(-lo));
+    let (y0, y1) = (to_px(-hi), to_px(-lo));
+    let overlap = |a: f32, b: f32, p: f32| (b.min(p + 1.0) - a.max(p)).max(0.0);
+    for backend in backends() {
+        let image = solve_and_render(&scene, backend, Options::default());
+        let mut worst = 0.0f32;
+        for y in 0..64 {
+            for x in 0..64 {
+                let cover = overlap(x0, x1, x as f32) * overlap(y0, y1, y as f32);
+                let seen = image.pixels[y * 64 + x].x / 50.0;
+                worst = worst.max((seen - cover).abs());
+            }
+        }
+        assert!(
+            worst <= 1.0 / 16.0 + 1e-3,
+            "{backend}: worst coverage error {worst}"
+        );
+    }
 }

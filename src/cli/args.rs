@@ -136,6 +136,10 @@ pub enum Command {
         /// Rays per side on pixels that straddle an edge (1 = one ray per pixel).
         #[arg(long, default_value_t = 4)]
         supersample: u32,
+        /// Meshless: shadow rays per area light traced at each camera hit for its direct light
+        /// (one per point light); 0 interpolates the direct light from the samples, as the paper.
+        #[arg(long, default_value_t = 16)]
+        direct_rays: u32,
         /// How to compute the image: meshless (the solver), or pathtrace (the independent
         /// reference: unbiased Monte Carlo path tracing).
         #[arg(long, default_value = "meshless")]
@@ -202,6 +206,10 @@ pub enum Command {
         /// Rays per side on edge pixels (meshless) or per pixel (patches).
         #[arg(long, default_value_t = 4)]
         supersample: u32,
+        /// Meshless: shadow rays per area light traced at each camera hit for its direct light;
+        /// 0 interpolates it from the samples.
+        #[arg(long, default_value_t = 16)]
+        direct_rays: u32,
         /// Patches: the side of the square patches (default: the solver's ε).
         #[arg(long)]
         patch_size: Option<f32>,

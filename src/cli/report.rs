@@ -377,8 +377,8 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
 /// The render's summary.
 pub fn render_summary(image: &Image, stats: &RenderStats, seconds: f64) -> String {
     format!(
-        "render {}x{}: {} camera rays ({} edge pixels supersampled), {} interpolation queries, {:.3} s; mean radiance {:.5}\n",
-        image.width, image.height, stats.camera_rays, stats.supersampled_pixels, stats.interpolation_queries, seconds, image.mean()
+        "render {}x{}: {} camera rays ({} edge pixels supersampled), {} interpolation queries, {} shadow rays, {:.3} s; mean radiance {:.5}\n",
+        image.width, image.height, stats.camera_rays, stats.supersampled_pixels, stats.interpolation_queries, stats.shadow_rays, seconds, image.mean()
     )
 }
 

@@ -34,6 +34,7 @@ const KEYS: &[&str] = &[
     "threads",
     "seed",
     "supersample",
+    "direct-rays",
     "patch-size",
     "spp",
 ];
@@ -54,6 +55,8 @@ pub struct Sweep {
     pub knobs: super::Knobs,
     /// Rays per side on edge pixels (meshless) or per pixel (patches).
     pub supersample: u32,
+    /// Meshless: shadow rays per area light at each camera hit (0: interpolated direct light).
+    pub direct_rays: u32,
     /// Patch side (patches; default the solver's ε).
     pub patch_size: Option<f32>,
     /// Samples per pixel (pathtrace).
@@ -117,6 +120,8 @@ fn used_by(method: Method, key: &str) -> bool {
 #[derive(Clone, Copy)]
 struct Extra {
     supersample: u32,
+    /// Shadow rays per area light at each camera hit (0: direct light interpolated).
+    direct_rays: u32,
     patch_size: Option<f32>,
     spp: u32,
     /// Errors on averages over blocks of this many pixels a side.
@@ -150,6 +155,7 @@ fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
         "threads" => o.threads = value::<usize>(key, v)?.max(1),
         "seed" => o.seed = value(key, v)?,
         "supersample" => extra.supersample = value::<u32>(key, v)?.max(1),
+        "direct-rays" => extra.direct_rays = value(key, v)?,
         "patch-size" => extra.patch_size = Some(value(key, v)?),
         "spp" => extra.spp = value(key, v)?,
         other => bail!("--vary: unknown setting '{other}'"),
@@ -223,6 +229,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
         let mut options = super::options_from(sweep.epsilon, &knobs)?;
         let mut extra = Extra {
             supersample: sweep.supersample.max(1),
+            direct_rays: sweep.direct_rays,
             patch_size: sweep.patch_size,
             spp: sweep.spp,
             block: sweep.block,
@@ -289,6 +296,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
         while spp <= sweep.max_spp.max(2) {
             let extra = Extra {
                 supersample: 1,
+                direct_rays: 0,
                 patch_size: None,
                 spp,
                 block: sweep.block,
@@ -400,6 +408,7 @@ fn measure(
                 &meshlight::RenderOptions {
                     threads: options.threads,
                     supersample: extra.supersample,
+                    direct: meshlight::Direct::from_rays(extra.direct_rays),
                     ..meshlight::RenderOptions::default()
                 },
             )?;

@@ -11,12 +11,16 @@ pub(crate) mod image;
 use glam::Vec3;
 
 use crate::error::Result;
+use crate::light::DirectLight;
 use crate::parallel::for_chunks;
 use crate::sampling::{cover, is_back, side_of, surface_of, Side};
 use crate::scene::Scene;
 use crate::solver::Solution;
 use crate::visibility::{Hit, Ray, Segment, Visibility};
 pub use image::Image;
+
+/// Edge pixels of high contrast get up to this many times `supersample` rays per side.
+const MAX_EDGE_BOOST: usize = 4;
 
 /// Kernel support: a sample reaches this many of its radii D.
 const SUPPORT: f32 = 2.0;
@@ -30,6 +34,33 @@ pub struct RenderOptions {
     pub supersample: u32,
     /// What each pixel holds.
     pub quantity: Quantity,
+    /// How a pixel gets its direct light.
+    pub direct: Direct,
+}
+
+/// Where a pixel's direct light comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direct {
+    /// Interpolated from the samples with the rest of their light, as the paper renders: shadow
+    /// edges and highlights are as sharp as the samples are dense.
+    Interpolated,
+    /// Integrated at each camera hit with the solver's estimator (`light_samples` shadow rays per
+    /// area light, one per point light); only the inter-reflected light is interpolated.
+    Traced {
+        /// Shadow rays per area light and hit.
+        light_samples: u32,
+    },
+}
+
+impl Direct {
+    /// The direct light traced with `light_samples` shadow rays per area light, or interpolated
+    /// for 0.
+    pub fn from_rays(light_samples: u32) -> Direct {
+        match light_samples {
+            0 => Direct::Interpolated,
+            n => Direct::Traced { light_samples: n },
+        }
+    }
 }
 
 /// What a rendered image holds per pixel.
@@ -49,6 +80,7 @@ impl Default for RenderOptions {
             threads: crate::solver::Options::default().threads,
             supersample: 4,
             quantity: Quantity::Radiance,
+            direct: Direct::Traced { light_samples: 16 },
         }
     }
 }
@@ -60,6 +92,8 @@ pub struct RenderStats {
     pub camera_rays: u64,
     /// Visibility queries between hits and samples.
     pub interpolation_queries: u64,
+    /// Shadow rays traced at hits for their direct light.
+    pub shadow_rays: u64,
     /// Pixels that got the grid of rays.
     pub supersampled_pixels: u64,
 }
@@ -76,7 +110,7 @@ pub fn render(
         camera.check()?;
         solution.check_fits(scene)?;
         let (w, h) = (camera.width as usize, camera.height as usize);
-        let shader = Shader::new(scene, solution, vis, options.quantity);
+        let shader = Shader::new(scene, solution, vis, options);
         let mut stats = RenderStats::default();
 
         // Centre rays: radiance and the side each pixel sees.
@@ -87,33 +121,55 @@ pub fn render(
                 .map(|p| camera_ray(scene, (p % w) as f32 + 0.5, (p / w) as f32 + 0.5))
                 .collect();
             queries.fetch_add(
-                shader.shade(&rays, out)?,
+                shader.shade(&rays, first as u32, out)?,
                 std::sync::atomic::Ordering::Relaxed,
             );
             Ok(())
         })?;
         stats.camera_rays = (w * h) as u64;
 
-        // Edge pixels: a neighbour sees another side.
+        // Edge pixels: a neighbour, diagonal ones included (a corner may cut a pixel whose four
+        // nearest neighbours all see what it sees), sees another side.
         let n = options.supersample.max(1) as usize;
         let edges: Vec<usize> = if n > 1 {
             (0..w * h)
-                .filter(|&p| {
-                    let (x, y) = (p % w, p / w);
-                    let side = centre[p].1;
-                    (x > 0 && centre[p - 1].1 != side)
-                        || (x + 1 < w && centre[p + 1].1 != side)
-                        || (y > 0 && centre[p - w].1 != side)
-                        || (y + 1 < h && centre[p + w].1 != side)
-                })
+                .filter(|&p| neighbours(p, w, h).any(|q| centre[q].1 != centre[p].1))
                 .collect()
         } else {
             Vec::new()
         };
+        // Rays per side for each edge pixel: `n`, more where the edge's contrast is high (the
+        // rim of a light): a jittered grid's coverage error scales with the contrast.
+        let mean = centre.iter().map(|c| c.0.element_sum()).sum::<f32>() / (3 * w * h) as f32;
+        let sides: Vec<usize> = edges
+            .iter()
+            .map(|&p| {
+                let values = || neighbours(p, w, h).map(|q| centre[q].0.max_element());
+                let here = centre[p].0.max_element();
+                let contrast = values().fold(here, f32::max) - values().fold(here, f32::min);
+                let m = if mean > 0.0 {
+                    (contrast / mean)
+                        .sqrt()
+                        .ceil()
+                        .clamp(1.0, MAX_EDGE_BOOST as f32) as usize
+                } else {
+                    1
+                };
+                n * m
+            })
+            .collect();
+        // First ray id of each edge pixel: ids past the centre rays', one per ray.
+        let mut first_ray = Vec::with_capacity(edges.len() + 1);
+        let mut total = w * h;
+        for &k in &sides {
+            first_ray.push(total);
+            total += k * k;
+        }
+        first_ray.push(total);
         let mut refined = vec![Vec3::ZERO; edges.len()];
         for_chunks(&mut refined, 64, options.threads, |first, out| {
-            let mut rays = Vec::with_capacity(out.len() * n * n);
-            for &p in &edges[first..first + out.len()] {
+            let mut rays = Vec::with_capacity(first_ray[first + out.len()] - first_ray[first]);
+            for (&p, &n) in edges[first..first + out.len()].iter().zip(&sides[first..]) {
                 let (x, y) = ((p % w) as f32, (p / w) as f32);
                 // Stratified and jittered: a regular grid measures a straight edge's coverage in
                 // steps of 1/n with the same error all along the edge, which biased the mean of a
@@ -137,17 +193,21 @@ pub fn render(
             }
             let mut shaded = vec![(Vec3::ZERO, 0u32); rays.len()];
             queries.fetch_add(
-                shader.shade(&rays, &mut shaded)?,
+                shader.shade(&rays, first_ray[first] as u32, &mut shaded)?,
                 std::sync::atomic::Ordering::Relaxed,
             );
-            for (o, group) in out.iter_mut().zip(shaded.chunks(n * n)) {
+            let mut rest = &shaded[..];
+            for (o, &n) in out.iter_mut().zip(&sides[first..]) {
+                let (group, tail) = rest.split_at(n * n);
                 *o = group.iter().map(|s| s.0).sum::<Vec3>() / (n * n) as f32;
+                rest = tail;
             }
             Ok(())
         })?;
-        stats.camera_rays += (edges.len() * n * n) as u64;
+        stats.camera_rays += (total - w * h) as u64;
         stats.supersampled_pixels = edges.len() as u64;
         stats.interpolation_queries = queries.into_inner();
+        stats.shadow_rays = shader.shadow_rays.into_inner();
 
         let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
         for (&p, &value) in edges.iter().zip(&refined) {
@@ -162,6 +222,17 @@ pub fn render(
             stats,
         ))
     })
+}
+
+/// The up to eight pixels around pixel p of a w × h image.
+fn neighbours(p: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
+    let (x, y) = ((p % w) as isize, (p / w) as isize);
+    (-1..=1isize)
+        .flat_map(move |dy| (-1..=1isize).map(move |dx| (x + dx, y + dy)))
+        .filter(move |&(i, j)| {
+            (i, j) != (x, y) && i >= 0 && j >= 0 && (i as usize) < w && (j as usize) < h
+        })
+        .map(move |(i, j)| j as usize * w + i as usize)
 }
 
 fn camera_ray(scene: &Scene, x: f32, y: f32) -> Ray {
@@ -183,7 +254,14 @@ struct Shader<'a> {
     support: Vec<f32>,
     /// What the pixels hold.
     quantity: Quantity,
+    /// Direct light traced at the hits, when the pixels take theirs from there.
+    light: Option<DirectLight>,
+    /// Shadow rays traced so far.
+    shadow_rays: std::sync::atomic::AtomicU64,
 }
+
+/// Seed of the shadow rays traced at camera hits: a fixed one, so a render repeats.
+const DIRECT_SEED: u64 = 0x6d65_7368_6c69_6768;
 
 /// A hit waiting for its visibility answers.
 struct Pending {
@@ -193,6 +271,7 @@ struct Pending {
     /// Radiance when no sample is involved (misses, emitters without samples, black sides).
     fixed: Option<Vec3>,
     point: Vec3,
+    normal: Vec3,
     /// Whether something hovers over the hit.
     covered: bool,
 }
@@ -202,7 +281,7 @@ impl<'a> Shader<'a> {
         scene: &'a Scene,
         solution: &'a Solution,
         vis: &'a dyn Visibility,
-        quantity: Quantity,
+        options: &RenderOptions,
     ) -> Self {
         let s = &solution.samples;
         let mut support = vec![0.0f32; 2 * scene.surfaces.len()];
@@ -215,15 +294,32 @@ impl<'a> Shader<'a> {
             vis,
             lift: crate::visibility::lift(scene),
             support,
-            quantity,
+            quantity: options.quantity,
+            light: match options.direct {
+                // A solution without its samples' direct light cannot be split.
+                Direct::Traced { light_samples } if solution.direct.len() == s.len() => {
+                    Some(DirectLight::new(scene, light_samples))
+                }
+                _ => None,
+            },
+            shadow_rays: std::sync::atomic::AtomicU64::new(0),
         }
     }
 
-    /// What sample k shows: its radiance B/π, or its irradiance.
+    /// What sample k shows: its radiance B/π, or its irradiance; without its direct light
+    /// when that is traced at the hits.
     fn value(&self, k: usize) -> glam::DVec3 {
+        let sol = self.solution;
+        let direct = match self.light {
+            Some(_) => sol.direct[k].irradiance,
+            None => glam::DVec3::ZERO,
+        };
         match self.quantity {
-            Quantity::Radiance => self.solution.radiosity[k] / std::f64::consts::PI,
-            Quantity::Irradiance => self.solution.irradiance[k],
+            Quantity::Radiance => {
+                let rho = crate::solver::reflectance_of(self.scene, &sol.samples, k);
+                (sol.radiosity[k] - rho * direct) / std::f64::consts::PI
+            }
+            Quantity::Irradiance => sol.irradiance[k] - direct,
         }
     }
 
@@ -232,8 +328,9 @@ impl<'a> Shader<'a> {
         self.solution.covered.get(k).copied().unwrap_or(false)
     }
 
-    /// Shades a batch of rays: (radiance, side seen or u32::MAX). Returns visibility queries.
-    fn shade(&self, rays: &[Ray], out: &mut [(Vec3, u32)]) -> Result<u64> {
+    /// Shades a batch of rays: (radiance, side seen or u32::MAX). Ray i seeds its shadow rays
+    /// with id `first_id + i`. Returns visibility queries.
+    fn shade(&self, rays: &[Ray], first_id: u32, out: &mut [(Vec3, u32)]) -> Result<u64> {
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(rays, &mut hits)?;
         // Whether each hit that will be interpolated is covered, asked in one batch (hits on
@@ -276,6 +373,7 @@ impl<'a> Shader<'a> {
                     candidates: 0..0,
                     fixed: Some(Vec3::ZERO),
                     point: Vec3::ZERO,
+                    normal: Vec3::ZERO,
                     covered: false,
                 });
                 continue;
@@ -297,6 +395,7 @@ impl<'a> Shader<'a> {
                     candidates: 0..0,
                     fixed: Some(fixed),
                     point,
+                    normal: tri.normal,
                     covered: hit_covered,
                 });
                 continue;
@@ -327,6 +426,7 @@ impl<'a> Shader<'a> {
                 candidates: start..candidates.len(),
                 fixed: None,
                 point,
+                normal,
                 covered: hit_covered,
             });
         }
@@ -339,7 +439,10 @@ impl<'a> Shader<'a> {
             .iter()
             .map(|s| s.is_some() && answer.next().unwrap_or(false))
             .collect();
-        for (p, o) in pending.iter().zip(out.iter_mut()) {
+        let direct = self.direct_at(&pending, first_id)?;
+        self.shadow_rays
+            .fetch_add(direct.1, std::sync::atomic::Ordering::Relaxed);
+        for ((p, o), direct) in pending.iter().zip(out.iter_mut()).zip(&direct.0) {
             let radiance = match p.fixed {
                 Some(l) => l,
                 None => {
@@ -359,18 +462,52 @@ impl<'a> Shader<'a> {
                             break;
                         }
                     }
-                    if wsum > 0.0 {
+                    let interpolated = if wsum > 0.0 {
                         (sum / wsum).as_vec3()
                     } else {
                         let (l, q) = self.nearest_visible(p.side, p.point)?;
                         queries += q;
                         l
-                    }
+                    };
+                    interpolated + *direct
                 }
             };
             *o = (radiance, p.side);
         }
         Ok(queries)
+    }
+
+    /// The direct light each interpolated hit shows, traced there (zero where the pixels take it
+    /// from the samples); and the queries it took.
+    fn direct_at(&self, pending: &[Pending], first_id: u32) -> Result<(Vec<Vec3>, u64)> {
+        let mut shown = vec![Vec3::ZERO; pending.len()];
+        let Some(light) = &self.light else {
+            return Ok((shown, 0));
+        };
+        let lit: Vec<usize> = (0..pending.len())
+            .filter(|&i| pending[i].fixed.is_none())
+            .collect();
+        let points: Vec<(Vec3, Vec3)> = lit
+            .iter()
+            .map(|&i| (pending[i].point, pending[i].normal))
+            .collect();
+        let ids: Vec<u32> = lit
+            .iter()
+            .map(|&i| first_id.wrapping_add(i as u32))
+            .collect();
+        let mut arrivals = vec![crate::light::Arrival::default(); lit.len()];
+        let queries = light.batch(self.vis, &points, &ids, DIRECT_SEED, &mut arrivals)?;
+        for (&i, arrival) in lit.iter().zip(&arrivals) {
+            let e = arrival.irradiance;
+            shown[i] = match self.quantity {
+                Quantity::Radiance => {
+                    let rho = self.scene.material_of(surface_of(pending[i].side)).kd;
+                    rho * e.as_vec3() / std::f32::consts::PI
+                }
+                Quantity::Irradiance => e.as_vec3(),
+            };
+        }
+        Ok((shown, queries))
     }
 
     /// Fallback where no sample's kernel reaches a visible hit: the nearest visible sample of

@@ -37,6 +37,7 @@ use phases::{AddedSamples, Solve};
 pub use progress::{Control, Phase, Progress};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
 pub(crate) use warm::emission as emission_of;
+pub(crate) use warm::reflectance as reflectance_of;
 use warm::reflectance;
 
 /// The solved samples.
