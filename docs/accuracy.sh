@@ -57,5 +57,5 @@ done
 "$M" sweep room/scene.toml --reference ref_room.exr --method patches --vary patch-size=0.5,0.35,0.25,0.18,0.125 \
   --no-pathtrace --out sw_room_patches > sw_room_patches.txt 2>/dev/null
 "$M" sweep gallery/scene.toml --reference ref_gallery.exr --vary epsilon=0.6,0.45,0.3,0.2,0.15 --vary rounds=0,2 \
-  --out sw_gallery --pathtrace-seconds 120 --max-spp 16384 > sw_gallery.txt 2>/dev/null
+  --block 4 --out sw_gallery --pathtrace-seconds 100 --max-spp 4096 > sw_gallery.txt 2>/dev/null
 echo "done: $OUT"
