@@ -197,7 +197,7 @@ pub enum Command {
         /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
         /// Keys: preset, epsilon, zeta, alpha, rounds, light-samples, tolerance, max-shots,
         /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
-        /// supersample, patch-size, spp.
+        /// supersample, direct-rays, patch-size, spp.
         #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
         vary: Vec<(String, Vec<String>)>,
         /// How each run computes its image.

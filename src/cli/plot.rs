@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use anyhow::{anyhow, Context, Result};
-use plotters::coord::combinators::IntoLogRange;
+use plotters::coord::combinators::{IntoLogRange, LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
@@ -388,6 +388,45 @@ pub struct Series {
     pub colour: RGBColor,
 }
 
+/// The ticks of a logarithmic axis over [lo, hi]: 1, 2 and 5 of each decade labelled, the other
+/// integers of each decade as light lines.
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut bold, mut light) = (Vec::new(), Vec::new());
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return (bold, light);
+    }
+    for k in lo.log10().floor() as i32..=hi.log10().ceil() as i32 {
+        let decade = 10f64.powi(k);
+        for m in 1..10 {
+            let v = f64::from(m) * decade;
+            if v >= lo && v <= hi {
+                if matches!(m, 1 | 2 | 5) {
+                    bold.push(v);
+                } else {
+                    light.push(v);
+                }
+            }
+        }
+    }
+    (bold, light)
+}
+
+/// A logarithmic axis over [lo, hi] with 1-2-5 ticks.
+fn log_axis(lo: f64, hi: f64) -> WithKeyPoints<LogCoord<f64>> {
+    let (bold, light) = log_ticks(lo, hi);
+    (lo..hi)
+        .log_scale()
+        .with_key_points(bold)
+        .with_light_points(light)
+}
+
+/// A tick label without trailing zeros: 0.5, 2, 10, 0.02.
+fn short_number(v: f64) -> String {
+    let s = format!("{v:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
 /// Writes a log-log plot of error (percent) against seconds.
 pub fn error_time_png(path: &Path, title: &str, series: &[Series]) -> Result<()> {
     font()?;
@@ -417,7 +456,7 @@ pub fn error_time_png(path: &Path, title: &str, series: &[Series]) -> Result<()>
             .margin(14)
             .x_label_area_size(44)
             .y_label_area_size(64)
-            .build_cartesian_2d((t0..t1).log_scale(), (e0..e1).log_scale())
+            .build_cartesian_2d(log_axis(t0, t1), log_axis(e0, e1))
             .map_err(plot_error)?;
         chart
             .configure_mesh()
@@ -425,6 +464,8 @@ pub fn error_time_png(path: &Path, title: &str, series: &[Series]) -> Result<()>
             .y_desc("MAE / mean, % (log)")
             .light_line_style(RGBColor(238, 238, 238))
             .label_style(("sans-serif", 14))
+            .x_label_formatter(&|v| short_number(*v))
+            .y_label_formatter(&|v| short_number(*v))
             .draw()
             .map_err(plot_error)?;
         for s in series {
@@ -476,6 +517,16 @@ mod tests {
         assert_eq!(diverging(f32::NAN), diverging(0.0));
         // Halfway between the white and the light red stop.
         assert_eq!(diverging(0.25), [246, 206, 189]);
+    }
+
+    #[test]
+    fn log_axes_tick_each_decade_once() {
+        let (bold, light) = log_ticks(0.35, 20.0);
+        assert_eq!(bold, [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]);
+        assert_eq!(light.len(), 5 + 6);
+        assert_eq!(short_number(10.0), "10");
+        assert_eq!(short_number(0.5), "0.5");
+        assert_eq!(short_number(0.02), "0.02");
     }
 
     #[test]

@@ -140,18 +140,20 @@ pub fn render(
         };
         // Rays per side for each edge pixel: `n`, more where the edge's contrast is high (the
         // rim of a light): a jittered grid's coverage error scales with the contrast.
-        let mean = centre.iter().map(|c| c.0.element_sum()).sum::<f32>() / (3 * w * h) as f32;
+        let mean = centre
+            .iter()
+            .map(|c| f64::from(c.0.element_sum()))
+            .sum::<f64>()
+            / (3 * w * h) as f64;
         let sides: Vec<usize> = edges
             .iter()
             .map(|&p| {
                 let values = || neighbours(p, w, h).map(|q| centre[q].0.max_element());
                 let here = centre[p].0.max_element();
                 let contrast = values().fold(here, f32::max) - values().fold(here, f32::min);
-                let m = if mean > 0.0 {
-                    (contrast / mean)
-                        .sqrt()
-                        .ceil()
-                        .clamp(1.0, MAX_EDGE_BOOST as f32) as usize
+                let ratio = f64::from(contrast) / mean;
+                let m = if ratio.is_finite() && ratio > 1.0 {
+                    (ratio.sqrt().ceil() as usize).min(MAX_EDGE_BOOST)
                 } else {
                     1
                 };
