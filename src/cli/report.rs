@@ -364,6 +364,20 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         meshlight::solver::human_bytes(bytes as f64),
         meshlight::solver::human_bytes(o.memory_budget as f64),
     );
+    let emitted = s.ledger.emitted.element_sum();
+    if emitted > 0.0 {
+        // Where the light went: a closed scene's "left" is what the lights that reflect
+        // nothing took, plus what the transfer lost; an open one's adds its openings.
+        let share = |p: f64| 100.0 * p / emitted;
+        let _ = writeln!(
+            out,
+            "energy: of the emitted power, {:.2}% absorbed by the surfaces, {:.2}% left them \
+             (openings, lights that reflect nothing, transfer losses), {:.2}% unshot",
+            share(s.absorbed(scene).element_sum()),
+            share(s.ledger.escaped.element_sum()),
+            share(s.unshot_power().element_sum())
+        );
+    }
     if s.stop() == StopReason::ShotLimit {
         let _ = writeln!(
             out,
