@@ -365,7 +365,9 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         meshlight::solver::human_bytes(o.memory_budget as f64),
     );
     let emitted = s.ledger.emitted.element_sum();
-    if emitted > 0.0 {
+    // Adaptive rounds start new samples from interpolated light, which the ledger does not
+    // follow: only a single solve's account adds up.
+    if emitted > 0.0 && s.rounds.len() == 1 {
         // Where the light went: a closed scene's "left" is what the lights that reflect
         // nothing took, plus what the transfer lost; an open one's adds its openings.
         let share = |p: f64| 100.0 * p / emitted;
