@@ -1,10 +1,12 @@
-//! Rendering (method.md §7): camera rays through the backend's closest hit; the radiance at a
-//! hit is interpolated from the samples of the same surface side with smooth, normalised,
-//! compactly supported weights sized by each sample's radius D (after Zwicker et al. 2001,
-//! surface splatting). A sample contributes only if the segment from the hit to it is clear,
-//! so light never passes through a thin wall or around a corner. Pixels are box-filtered:
-//! one ray through the centre, and a grid of rays where the pixel straddles an edge between
-//! surfaces.
+//! Rendering (method.md §7): camera rays through the backend's closest hit. The direct light at
+//! a hit is traced there with the solver's estimator ([`Direct::Traced`]; the paper
+//! interpolates it too, [`Direct::Interpolated`]); the rest of its radiance is interpolated
+//! from the samples of the same surface side with smooth, normalised, compactly supported
+//! weights sized by each sample's radius D (after Zwicker et al. 2001, surface splatting). A
+//! sample contributes only if the segment from the hit to it is clear, so light never passes
+//! through a thin wall or around a corner. Pixels are box-filtered: one ray through the centre,
+//! and a jittered grid of rays where the pixel or a neighbour sees another surface side, finer
+//! where the edge's contrast is high.
 
 pub(crate) mod image;
 
