@@ -18,6 +18,13 @@ use crate::sampling::poisson::side_seed;
 use crate::scene::{PointSource, Scene};
 use crate::visibility::{Segment, Visibility};
 
+/// The most shadow rays per area light and receiver a caller may ask for.
+pub const MAX_LIGHT_SAMPLES: u32 = 1 << 16;
+
+/// Shadow rays one visibility call carries at most: a batch of receivers is cut to fit, so
+/// memory stays bounded whatever the count per receiver.
+const RAYS_PER_CALL: usize = 1 << 20;
+
 /// The golden ratio's fractional part: the Fibonacci lattice's second coordinate.
 const GOLDEN: f64 = 0.618_033_988_749_894_8;
 
@@ -137,8 +144,29 @@ impl DirectLight {
         Ok((out, queries.into_inner()))
     }
 
-    /// One batch: the shadow rays of its receivers, one visibility call per kind of light.
+    /// One batch: the shadow rays of its receivers, one visibility call per kind of light and
+    /// part of the batch (parts of at most [`RAYS_PER_CALL`] rays).
     pub(crate) fn batch(
+        &self,
+        vis: &dyn Visibility,
+        points: &[(Vec3, Vec3)],
+        ids: &[u32],
+        seed: u64,
+        out: &mut [Arrival],
+    ) -> Result<u64> {
+        let part = (RAYS_PER_CALL / self.rays_per_receiver().max(1)).max(1);
+        let mut queries = 0;
+        for ((points, ids), out) in points
+            .chunks(part)
+            .zip(ids.chunks(part))
+            .zip(out.chunks_mut(part))
+        {
+            queries += self.batch_part(vis, points, ids, seed, out)?;
+        }
+        Ok(queries)
+    }
+
+    fn batch_part(
         &self,
         vis: &dyn Visibility,
         points: &[(Vec3, Vec3)],

@@ -18,7 +18,7 @@ use crate::visibility::{Segment, Visibility};
 /// How grid points are measured.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LuxOptions {
-    /// Shadow rays per area light and point.
+    /// Shadow rays per area light and point, 1 to [`crate::light::MAX_LIGHT_SAMPLES`].
     pub light_samples: u32,
     /// Seed of the shadow rays.
     pub seed: u64,
@@ -48,6 +48,16 @@ pub fn illuminance(
 ) -> Result<Vec<DVec3>> {
     crate::parallel::guarded("the illuminance gather", || {
         solution.check_fits(scene)?;
+        if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&options.light_samples) {
+            return Err(crate::Error::argument(
+                "light_samples",
+                format!(
+                    "{} shadow rays per area light: must lie in 1..={}",
+                    options.light_samples,
+                    crate::light::MAX_LIGHT_SAMPLES
+                ),
+            ));
+        }
         let points = grid.points();
         let n = grid.normal;
         // Direct light: the solver's estimator at the points, facing the grid's normal.

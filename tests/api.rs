@@ -106,6 +106,55 @@ fn scaling_by_nonsense_is_an_error() {
     assert_eq!(dark.emitted_power(), DVec3::ZERO);
 }
 
+#[test]
+fn shadow_ray_counts_out_of_range_are_errors() {
+    let cube = box_scene();
+    let vis = Backend::Bvh.build(&cube).unwrap();
+    let max = meshlight::light::MAX_LIGHT_SAMPLES;
+    for light_samples in [0, max + 1, u32::MAX] {
+        let options = Options {
+            light_samples,
+            ..Options::default()
+        };
+        let e = meshlight::solve(&cube, vis.as_ref(), &options, &mut |_| Control::Continue)
+            .unwrap_err();
+        assert!(matches!(e, Error::Option { .. }), "{light_samples}: {e}");
+    }
+    let solution = solve(&cube);
+    for light_samples in [0, max + 1, u32::MAX] {
+        let options = RenderOptions {
+            direct: meshlight::Direct::Traced { light_samples },
+            ..RenderOptions::default()
+        };
+        let e = meshlight::render(&cube, &solution, vis.as_ref(), &options).unwrap_err();
+        assert!(matches!(e, Error::Argument { .. }), "{light_samples}: {e}");
+        let grid = meshlight::scene::Grid {
+            name: "g".into(),
+            origin: Vec3::splat(0.4),
+            u: Vec3::X * 0.2,
+            v: Vec3::Z * 0.2,
+            normal: Vec3::Y,
+            spacing: 0.1,
+            n_u: 2,
+            n_v: 2,
+        };
+        let options = meshlight::lux::LuxOptions {
+            light_samples,
+            ..Default::default()
+        };
+        let e = meshlight::lux::illuminance(
+            &cube,
+            &solution,
+            vis.as_ref(),
+            &grid,
+            &options,
+            &mut |_| {},
+        )
+        .unwrap_err();
+        assert!(matches!(e, Error::Argument { .. }), "{light_samples}: {e}");
+    }
+}
+
 /// A host's backend that panics on its `fail_at`-th call.
 struct Faulty {
     inner: Box<dyn Visibility>,

@@ -138,7 +138,8 @@ pub enum Command {
         supersample: u32,
         /// Meshless: shadow rays per area light traced at each camera hit for its direct light
         /// (one per point light); 0 interpolates the direct light from the samples, as the paper.
-        #[arg(long, default_value_t = 16)]
+        #[arg(long, default_value_t = 16,
+              value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::light::MAX_LIGHT_SAMPLES)))]
         direct_rays: u32,
         /// How to compute the image: meshless (the solver), or pathtrace (the independent
         /// reference: unbiased Monte Carlo path tracing).
@@ -208,7 +209,8 @@ pub enum Command {
         supersample: u32,
         /// Meshless: shadow rays per area light traced at each camera hit for its direct light;
         /// 0 interpolates it from the samples.
-        #[arg(long, default_value_t = 16)]
+        #[arg(long, default_value_t = 16,
+              value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::light::MAX_LIGHT_SAMPLES)))]
         direct_rays: u32,
         /// Patches: the side of the square patches (default: the solver's ε).
         #[arg(long)]
@@ -244,7 +246,8 @@ pub enum Command {
         #[arg(short, long, default_value = ".")]
         output: PathBuf,
         /// Shadow rays per area light and grid point.
-        #[arg(long, default_value_t = 64)]
+        #[arg(long, default_value_t = 64,
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::light::MAX_LIGHT_SAMPLES)))]
         grid_light_samples: u32,
     },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.

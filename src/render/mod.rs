@@ -49,14 +49,14 @@ pub enum Direct {
     /// Integrated at each camera hit with the solver's estimator (`light_samples` shadow rays per
     /// area light, one per point light); only the inter-reflected light is interpolated.
     Traced {
-        /// Shadow rays per area light and hit.
+        /// Shadow rays per area light and hit, 1 to [`crate::light::MAX_LIGHT_SAMPLES`].
         light_samples: u32,
     },
 }
 
 impl Direct {
     /// The direct light traced with `light_samples` shadow rays per area light, or interpolated
-    /// for 0.
+    /// for 0 (as `render --direct-rays` takes it).
     pub fn from_rays(light_samples: u32) -> Direct {
         match light_samples {
             0 => Direct::Interpolated,
@@ -111,6 +111,17 @@ pub fn render(
         let camera = &scene.camera;
         camera.check()?;
         solution.check_fits(scene)?;
+        if let Direct::Traced { light_samples } = options.direct {
+            if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&light_samples) {
+                return Err(crate::Error::argument(
+                    "direct",
+                    format!(
+                        "{light_samples} shadow rays per area light: must lie in 1..={}",
+                        crate::light::MAX_LIGHT_SAMPLES
+                    ),
+                ));
+            }
+        }
         let (w, h) = (camera.width as usize, camera.height as usize);
         let shader = Shader::new(scene, solution, vis, options);
         let mut stats = RenderStats::default();

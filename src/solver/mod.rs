@@ -421,8 +421,15 @@ fn check(options: &Options) -> Result<()> {
             format!("{} must lie in (0, 1)", options.tolerance),
         );
     }
-    if options.light_samples == 0 {
-        return fail("light-samples", "must be at least 1".into());
+    if options.light_samples == 0 || options.light_samples > crate::light::MAX_LIGHT_SAMPLES {
+        return fail(
+            "light-samples",
+            format!(
+                "{} must lie in 1..={}",
+                options.light_samples,
+                crate::light::MAX_LIGHT_SAMPLES
+            ),
+        );
     }
     if !(options.cluster_threshold.is_finite() && options.cluster_threshold >= 0.0) {
         return fail(

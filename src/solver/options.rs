@@ -19,7 +19,8 @@ pub struct Options {
     /// the error exceeds ζ and solves again from the previous solution.
     pub rounds: u32,
     /// Shadow rays per area light and sample, useful 4–256: more gives smoother penumbrae at
-    /// proportional direct-light cost. Unused without area lights.
+    /// proportional direct-light cost; at most [`crate::light::MAX_LIGHT_SAMPLES`]. Unused
+    /// without area lights.
     pub light_samples: u32,
     /// Shooting stops when the unshot power falls below this fraction of the emitted power,
     /// useful 1e-5–1e-2.
