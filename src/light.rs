@@ -166,6 +166,7 @@ impl DirectLight {
         Ok(queries)
     }
 
+    /// [`DirectLight::batch`] for a part that fits in one call per kind of light.
     fn batch_part(
         &self,
         vis: &dyn Visibility,

@@ -158,7 +158,7 @@ pub fn render(
             .map(|c| f64::from(c.0.element_sum()))
             .sum::<f64>()
             / (3 * w * h) as f64;
-        let sides: Vec<usize> = edges
+        let per_side: Vec<usize> = edges
             .iter()
             .map(|&p| {
                 let values = || neighbours(p, w, h).map(|q| centre[q].0.max_element());
@@ -176,7 +176,7 @@ pub fn render(
         // First ray id of each edge pixel: ids past the centre rays', one per ray.
         let mut first_ray = Vec::with_capacity(edges.len() + 1);
         let mut total = w * h;
-        for &k in &sides {
+        for &k in &per_side {
             first_ray.push(total);
             total += k * k;
         }
@@ -184,7 +184,10 @@ pub fn render(
         let mut refined = vec![Vec3::ZERO; edges.len()];
         for_chunks(&mut refined, 64, options.threads, |first, out| {
             let mut rays = Vec::with_capacity(first_ray[first + out.len()] - first_ray[first]);
-            for (&p, &n) in edges[first..first + out.len()].iter().zip(&sides[first..]) {
+            for (&p, &n) in edges[first..first + out.len()]
+                .iter()
+                .zip(&per_side[first..])
+            {
                 let (x, y) = ((p % w) as f32, (p / w) as f32);
                 // Stratified and jittered: a regular grid measures a straight edge's coverage in
                 // steps of 1/n with the same error all along the edge, which biased the mean of a
@@ -212,7 +215,7 @@ pub fn render(
                 std::sync::atomic::Ordering::Relaxed,
             );
             let mut rest = &shaded[..];
-            for (o, &n) in out.iter_mut().zip(&sides[first..]) {
+            for (o, &n) in out.iter_mut().zip(&per_side[first..]) {
                 let (group, tail) = rest.split_at(n * n);
                 *o = group.iter().map(|s| s.0).sum::<Vec3>() / (n * n) as f32;
                 rest = tail;
@@ -269,6 +272,8 @@ struct Shader<'a> {
     support: Vec<f32>,
     /// What the pixels hold.
     quantity: Quantity,
+    /// What each sample shows (see [`Shader::new`]), computed once: hits ask for it many times.
+    values: Vec<glam::DVec3>,
     /// Direct light traced at the hits, when the pixels take theirs from there.
     light: Option<DirectLight>,
     /// Shadow rays traced so far.
@@ -303,6 +308,30 @@ impl<'a> Shader<'a> {
         for (&side, &d) in s.side.iter().zip(&s.radius) {
             support[side as usize] = support[side as usize].max(SUPPORT * d);
         }
+        let light = match options.direct {
+            // A solution without its samples' direct light cannot be split.
+            Direct::Traced { light_samples } if solution.direct.len() == s.len() => {
+                Some(DirectLight::new(scene, light_samples))
+            }
+            _ => None,
+        };
+        // What sample k shows: its radiance B/π, or its irradiance; without its direct light
+        // when that is traced at the hits.
+        let values = (0..s.len())
+            .map(|k| {
+                let direct = match light {
+                    Some(_) => solution.direct[k].irradiance,
+                    None => glam::DVec3::ZERO,
+                };
+                match options.quantity {
+                    Quantity::Radiance => {
+                        let rho = crate::solver::reflectance_of(scene, s, k);
+                        (solution.radiosity[k] - rho * direct) / std::f64::consts::PI
+                    }
+                    Quantity::Irradiance => solution.irradiance[k] - direct,
+                }
+            })
+            .collect();
         Shader {
             scene,
             solution,
@@ -310,31 +339,9 @@ impl<'a> Shader<'a> {
             lift: crate::visibility::lift(scene),
             support,
             quantity: options.quantity,
-            light: match options.direct {
-                // A solution without its samples' direct light cannot be split.
-                Direct::Traced { light_samples } if solution.direct.len() == s.len() => {
-                    Some(DirectLight::new(scene, light_samples))
-                }
-                _ => None,
-            },
+            values,
+            light,
             shadow_rays: std::sync::atomic::AtomicU64::new(0),
-        }
-    }
-
-    /// What sample k shows: its radiance B/π, or its irradiance; without its direct light
-    /// when that is traced at the hits.
-    fn value(&self, k: usize) -> glam::DVec3 {
-        let sol = self.solution;
-        let direct = match self.light {
-            Some(_) => sol.direct[k].irradiance,
-            None => glam::DVec3::ZERO,
-        };
-        match self.quantity {
-            Quantity::Radiance => {
-                let rho = crate::solver::reflectance_of(self.scene, &sol.samples, k);
-                (sol.radiosity[k] - rho * direct) / std::f64::consts::PI
-            }
-            Quantity::Irradiance => sol.irradiance[k] - direct,
         }
     }
 
@@ -470,7 +477,7 @@ impl<'a> Shader<'a> {
                                 && (!alike || self.sample_covered(k as usize) == p.covered)
                             {
                                 wsum += f64::from(w);
-                                sum += f64::from(w) * self.value(k as usize);
+                                sum += f64::from(w) * self.values[k as usize];
                             }
                         }
                         if wsum > 0.0 {
@@ -558,7 +565,7 @@ impl<'a> Shader<'a> {
             queries += segments.len() as u64;
             if let Some(i) = blocked.iter().position(|b| !b) {
                 let k = near[i].0 as usize;
-                return Ok((self.value(k).as_vec3(), queries));
+                return Ok((self.values[k].as_vec3(), queries));
             }
         }
         Ok((Vec3::ZERO, queries))
