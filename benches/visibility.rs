@@ -52,7 +52,7 @@ fn visibility(c: &mut Criterion) {
         }
         group.sample_size(10);
         for backend in Backend::available() {
-            group.throughput(Throughput::Elements(scene.triangles.len() as u64));
+            group.throughput(Throughput::Elements(scene.triangles().len() as u64));
             group.bench_function(BenchmarkId::new("build", backend.name()), |b| {
                 b.iter(|| backend.build(&scene).expect("build backend"))
             });

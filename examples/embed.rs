@@ -20,7 +20,7 @@ impl BruteForce {
     /// Built from the loaded scene's triangles, in their order (hits name them by index).
     pub fn new(scene: &Scene) -> Self {
         BruteForce {
-            triangles: scene.triangles.iter().map(|t| t.vertices).collect(),
+            triangles: scene.triangles().iter().map(|t| t.vertices).collect(),
         }
     }
 
@@ -175,7 +175,9 @@ pub fn run(scene: &Scene, vis: &dyn Visibility, max_shots: u64) -> meshlight::Re
         threads: 2,
         ..RenderOptions::default()
     };
-    let (image, _) = meshlight::render(scene, &solution, vis, &render)?;
+    let (image, _) = meshlight::render(scene, &solution, vis, &render, &mut |_| {
+        meshlight::Control::Continue
+    })?;
     Ok(Run {
         solution,
         shots_seen,
@@ -192,8 +194,8 @@ fn main() -> meshlight::Result<()> {
     println!(
         "host room: {} triangles, {} samples; stopped after {} shots ({:?}), {} progress reports; \
          image {}x{}, mean radiance {:.4}",
-        scene.triangles.len(),
-        done.solution.samples.len(),
+        scene.triangles().len(),
+        done.solution.samples().len(),
         done.shots_seen,
         done.solution.stop(),
         done.reports,

@@ -7,7 +7,14 @@ use meshlight::{Backend, Image, RenderOptions, Scene, Solution};
 fn run(scene: &Scene, options: &Options) -> meshlight::Result<(Solution, Image)> {
     let vis = Backend::default_backend().build(scene)?;
     let solution = meshlight::solve(scene, vis.as_ref(), options, &mut |_| Control::Continue)?;
-    let image = meshlight::render(scene, &solution, vis.as_ref(), &RenderOptions::default())?.0;
+    let image = meshlight::render(
+        scene,
+        &solution,
+        vis.as_ref(),
+        &RenderOptions::default(),
+        &mut |_| meshlight::Control::Continue,
+    )?
+    .0;
     Ok((solution, image))
 }
 
@@ -45,13 +52,17 @@ fn main() -> meshlight::Result<()> {
         );
     }
     let white = room
-        .materials
+        .materials()
         .iter()
         .position(|m| m.name == "white")
         .expect("room has white");
     for kd in [0.725f32, 0.85, 0.95] {
         let mut scene = room.clone();
-        scene.materials[white].kd = glam::Vec3::splat(kd);
+        {
+            let mut m = scene.materials()[white].clone();
+            m.kd = glam::Vec3::splat(kd);
+            scene.set_material(white, m).unwrap();
+        }
         let (s, image) = run(
             &scene,
             &Options {
@@ -73,11 +84,13 @@ fn main() -> meshlight::Result<()> {
     let (s, image) = run(&room, &coarse)?;
     println!(
         "ε = 100: {} samples, mean radiance {:.2} of the default solve's",
-        s.samples.len(),
+        s.samples().len(),
         image.mean() / default.mean()
     );
     let mut bright = Scene::load(dir.join("box/scene.toml"))?;
-    bright.materials[0].kd = glam::Vec3::splat(0.99);
+    let mut white = bright.materials()[0].clone();
+    white.kd = glam::Vec3::splat(0.99);
+    bright.set_material(0, white)?;
     let expected = 0.1 / (1.0 - 0.99);
     let t = std::time::Instant::now();
     let tight = Options {
@@ -87,7 +100,7 @@ fn main() -> meshlight::Result<()> {
     };
     let (s, image) = run(&bright, &tight)?;
     let worst = s
-        .radiosity
+        .radiosity()
         .iter()
         .map(|b| (b.x / std::f64::consts::PI / expected - 1.0).abs())
         .fold(0.0, f64::max);
@@ -96,7 +109,7 @@ fn main() -> meshlight::Result<()> {
         .iter()
         .map(|p| (f64::from(p.x) / expected - 1.0).abs())
         .fold(0.0, f64::max);
-    let shots: u64 = s.rounds.iter().map(|r| r.shooting.shots).sum();
+    let shots: u64 = s.rounds().iter().map(|r| r.shooting.shots).sum();
     println!(
         "albedo 0.99 box: worst sample {worst:.1e}, worst pixel {worst_pixel:.1e} off Ke/(1-ρ); {shots} shots, {:?}, {:.2} s",
         s.stop(),
@@ -120,8 +133,8 @@ fn main() -> meshlight::Result<()> {
         println!(
             "albedo 0.99 box, {solver}, {shots} shots: {:?}, unshot fraction {:.3}, L {:.2} (converged: 10)",
             s.stop(),
-            s.rounds[0].shooting.unshot_fraction,
-            s.radiosity[0].x / std::f64::consts::PI
+            s.rounds()[0].shooting.unshot_fraction,
+            s.radiosity()[0].x / std::f64::consts::PI
         );
     }
     Ok(())

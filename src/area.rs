@@ -14,12 +14,13 @@
 use glam::{DVec3, Vec2};
 
 use crate::error::Result;
-use crate::parallel::{for_chunks, for_chunks_reporting};
+use crate::parallel::{for_chunks, for_chunks_reporting, Report};
 use crate::sampling::{surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::visibility::Visibility;
 
 /// What the area computation did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct AreaStats {
     /// Non-empty cells.
     pub cells: usize,
@@ -32,9 +33,11 @@ pub struct AreaStats {
 /// Computes every sample's area `S`, on up to `threads` threads (the result does not depend
 /// on their number). With `changed` (per side), only the sides it marks are recomputed: the
 /// others keep the cells and shares the last computation gave them (their samples and radii
-/// must not have changed since). `report` hears the share of cells done now and then.
+/// must not have changed since). `report` hears the share of cells done now and then; if it
+/// answers Stop, the cells not split yet go whole to their nearest sample, so every side's
+/// area is still conserved.
 #[allow(clippy::too_many_arguments)]
-pub fn compute(
+pub(crate) fn compute(
     samples: &mut Samples,
     maps: &[SurfaceMap],
     index: &SideIndex,
@@ -43,11 +46,83 @@ pub fn compute(
     (epsilon, alpha): (f32, f32),
     threads: usize,
     changed: Option<&[bool]>,
-    report: &mut dyn FnMut(f64),
+    report: Report,
 ) -> Result<AreaStats> {
-    // ε bounds the cell size where a side has only initial samples.
-    let mut stats = AreaStats::default();
-    // Per side: the smallest radius among its samples sets the cell size.
+    let sides = 2 * maps.len();
+    let redo = |side: usize| changed.is_none_or(|c| c.get(side).copied().unwrap_or(true));
+    let kept = if changed.is_some() {
+        previous_cells(samples, sides)
+    } else {
+        vec![0..0; sides]
+    };
+    let layout = lay_cells(samples, maps, epsilon, threads, &redo, &kept)?;
+    let mut stats = AreaStats {
+        cells: layout.cells.len(),
+        ..AreaStats::default()
+    };
+    let cx = Shares {
+        samples,
+        maps,
+        index,
+        obstruction,
+        vis,
+        alpha,
+    };
+    let chunks = cx.split(&layout, threads, report)?;
+    for chunk in &chunks {
+        stats.queries += chunk.queries;
+        stats.orphan_cells += chunk.orphans;
+    }
+    gather_shares(samples, &layout, chunks, &redo);
+    region_centroids(samples, threads)?;
+    Ok(stats)
+}
+
+/// The range of `samples.cells` each side holds from the last computation (cells are stored
+/// side by side).
+fn previous_cells(samples: &Samples, sides: usize) -> Vec<std::ops::Range<usize>> {
+    let mut kept = vec![0..0; sides];
+    let mut at = 0;
+    while at < samples.cells.len() {
+        let side = samples.cells[at].side as usize;
+        let end = at
+            + samples.cells[at..]
+                .iter()
+                .take_while(|c| c.side as usize == side)
+                .count();
+        if side < sides {
+            kept[side] = at..end;
+        }
+        at = end;
+    }
+    kept
+}
+
+/// The cells of one computation, side by side: kept cells where a side did not change (each
+/// with its old index), new ones (to split among samples) elsewhere.
+struct Layout {
+    /// Per cell: (side, area, 2D centroid); kept cells carry no area here (their shares are kept).
+    cells: Vec<(u32, f64, Vec2)>,
+    /// Per cell: its index in the last computation, if kept.
+    old: Vec<Option<u32>>,
+    /// Per cell: the cell as the samples store it.
+    stored: Vec<AreaCell>,
+    /// Per old cell: its new index (`u32::MAX` if dropped).
+    moved: Vec<u32>,
+}
+
+/// Cuts every changed side into cells (clipped side by side in parallel) and lists them with
+/// the kept ones.
+fn lay_cells(
+    samples: &Samples,
+    maps: &[SurfaceMap],
+    epsilon: f32,
+    threads: usize,
+    redo: &(dyn Fn(usize) -> bool + Sync),
+    kept: &[std::ops::Range<usize>],
+) -> Result<Layout> {
+    // Per side: the smallest radius among its samples sets the cell size (ε bounds it where a
+    // side has only initial samples).
     let sides = 2 * maps.len();
     let mut smallest = vec![f32::INFINITY; sides];
     let mut count = vec![0usize; sides];
@@ -55,25 +130,6 @@ pub fn compute(
         smallest[side as usize] = smallest[side as usize].min(d);
         count[side as usize] += 1;
     }
-    // The cells the last computation left on each side, to keep where nothing changed.
-    let redo = |side: usize| changed.is_none_or(|c| c.get(side).copied().unwrap_or(true));
-    let mut kept: Vec<std::ops::Range<usize>> = vec![0..0; sides];
-    if changed.is_some() {
-        let mut at = 0;
-        while at < samples.cells.len() {
-            let side = samples.cells[at].side as usize;
-            let end = at
-                + samples.cells[at..]
-                    .iter()
-                    .take_while(|c| c.side as usize == side)
-                    .count();
-            if side < sides {
-                kept[side] = at..end;
-            }
-            at = end;
-        }
-    }
-    // Every changed side's cells, clipped side by side in parallel: (cell size, cells).
     let active: Vec<usize> = (0..sides).filter(|&side| count[side] > 0).collect();
     let mut clipped: Vec<Clipped> = vec![(0.0, Vec::new()); active.len()];
     for_chunks(&mut clipped, 1, threads, |i, out| {
@@ -87,25 +143,27 @@ pub fn compute(
         clip_cells(map, cell, &mut out[0].1);
         Ok(())
     })?;
-    // The new cell list, side by side: kept cells where a side did not change (each with its
-    // old index), new ones (to split among samples) elsewhere.
-    let mut cells: Vec<(u32, f64, Vec2)> = Vec::new();
-    let mut old: Vec<Option<u32>> = Vec::new();
-    let mut all_cells: Vec<AreaCell> = Vec::new();
+    let mut layout = Layout {
+        cells: Vec::new(),
+        old: Vec::new(),
+        stored: Vec::new(),
+        moved: vec![u32::MAX; samples.cells.len()],
+    };
     for (&side, (cell, list)) in active.iter().zip(&clipped) {
         if !redo(side) {
             for i in kept[side].clone() {
-                all_cells.push(samples.cells[i]);
-                cells.push((side as u32, 0.0, Vec2::ZERO));
-                old.push(Some(i as u32));
+                layout.moved[i] = layout.cells.len() as u32;
+                layout.stored.push(samples.cells[i]);
+                layout.cells.push((side as u32, 0.0, Vec2::ZERO));
+                layout.old.push(Some(i as u32));
             }
             continue;
         }
         let map = &maps[surface_of(side as u32) as usize];
         for &(_, a, centroid) in list {
-            cells.push((side as u32, a, centroid));
-            old.push(None);
-            all_cells.push(AreaCell {
+            layout.cells.push((side as u32, a, centroid));
+            layout.old.push(None);
+            layout.stored.push(AreaCell {
                 centroid: map.to_3d(centroid),
                 area: a as f32,
                 half: 0.5 * cell,
@@ -113,43 +171,17 @@ pub fn compute(
             });
         }
     }
-    drop(clipped);
-    stats.cells = cells.len();
-    // Where each kept cell went.
-    let mut moved = vec![u32::MAX; samples.cells.len()];
-    for (new, o) in old.iter().enumerate() {
-        if let Some(o) = o {
-            moved[*o as usize] = new as u32;
-        }
-    }
+    Ok(layout)
+}
 
-    // Each new cell split among its samples (eq. 5), in parallel chunks of cells; each chunk's
-    // shares (cell, sample, area) in cell order.
-    let cx = Shares {
-        samples,
-        maps,
-        index,
-        obstruction,
-        vis,
-        alpha,
-    };
-    const CHUNK: usize = 1024;
-    let mut chunks: Vec<CellShares> = vec![CellShares::default(); cells.len().div_ceil(CHUNK)];
-    let split = |c: usize, out: &mut [CellShares]| {
-        let mut near = Vec::new();
-        for id in c * CHUNK..((c + 1) * CHUNK).min(cells.len()) {
-            if old[id].is_none() {
-                let (side, a, centroid) = cells[id];
-                let map = &maps[surface_of(side) as usize];
-                cx.of_cell(id as u32, side, map, a, centroid, &mut near, &mut out[0])?;
-            }
-        }
-        Ok(())
-    };
-    for_chunks_reporting(&mut chunks, 1, threads, split, report)?;
-
-    // Gather the shares by sample, in cell order within each sample (a counting sort): a sample
-    // on a kept side keeps its shares (their cells renumbered), the others take the new ones.
+/// Gathers the shares by sample, in cell order within each sample (a counting sort): a sample
+/// on a kept side keeps its shares (their cells renumbered), the others take the new ones.
+fn gather_shares(
+    samples: &mut Samples,
+    layout: &Layout,
+    chunks: Vec<CellShares>,
+    redo: &dyn Fn(usize) -> bool,
+) {
     let n = samples.len();
     let kept_sample =
         |k: usize| !redo(samples.side[k] as usize) && k + 1 < samples.share_start.len();
@@ -160,8 +192,6 @@ pub fn compute(
         }
     }
     for chunk in &chunks {
-        stats.queries += chunk.queries;
-        stats.orphan_cells += chunk.orphans;
         for &(_, k, _) in &chunk.shares {
             start[k as usize + 1] += 1;
         }
@@ -176,7 +206,7 @@ pub fn compute(
         if kept_sample(k) {
             for &(c, a) in samples.shares_of(k) {
                 area[k] += f64::from(a);
-                shares[next[k] as usize] = (moved[c as usize], a);
+                shares[next[k] as usize] = (layout.moved[c as usize], a);
                 next[k] += 1;
             }
         }
@@ -191,7 +221,13 @@ pub fn compute(
     }
     samples.share_start = start;
     samples.shares = shares;
-    samples.cells = all_cells;
+    samples.cells = layout.stored.clone();
+    samples.area = area;
+}
+
+/// Each sample's region centroid: the area-weighted centre of its shares (its position if it
+/// holds none).
+fn region_centroids(samples: &mut Samples, threads: usize) -> Result<()> {
     let mut centroids = std::mem::take(&mut samples.centroid);
     let shared: &Samples = samples;
     for_chunks(&mut centroids, 4096, threads, |first, chunk| {
@@ -211,13 +247,14 @@ pub fn compute(
         Ok(())
     })?;
     samples.centroid = centroids;
-    samples.area = area;
-    Ok(stats)
+    Ok(())
 }
 
 /// The shares of a run of cells: (cell, sample, area) in cell order.
 #[derive(Clone, Debug, Default)]
 struct CellShares {
+    /// Whether the run was split (a stopped computation leaves later runs undone).
+    done: bool,
     shares: Vec<(u32, u32, f64)>,
     /// Cells with no visible sample within R, given to the nearest one.
     orphans: usize,
@@ -234,7 +271,42 @@ struct Shares<'a> {
     alpha: f32,
 }
 
+/// Cells per parallel chunk of the split.
+const CHUNK: usize = 1024;
+
 impl Shares<'_> {
+    /// Splits the new cells among their samples (eq. 5), in parallel chunks of cells; each
+    /// chunk's shares (cell, sample, area) in cell order. Cells a Stop left unsplit go whole to
+    /// their nearest sample.
+    fn split(&self, layout: &Layout, threads: usize, report: Report) -> Result<Vec<CellShares>> {
+        let cells = &layout.cells;
+        let mut chunks: Vec<CellShares> = vec![CellShares::default(); cells.len().div_ceil(CHUNK)];
+        let split = |c: usize, out: &mut [CellShares]| {
+            let mut near = Vec::new();
+            out[0].done = true;
+            for id in c * CHUNK..((c + 1) * CHUNK).min(cells.len()) {
+                if layout.old[id].is_none() {
+                    let (side, a, centroid) = cells[id];
+                    let map = &self.maps[surface_of(side) as usize];
+                    self.of_cell(id as u32, side, map, a, centroid, &mut near, &mut out[0])?;
+                }
+            }
+            Ok(())
+        };
+        if !for_chunks_reporting(&mut chunks, 1, threads, split, report)? {
+            for (c, chunk) in chunks.iter_mut().enumerate().filter(|(_, c)| !c.done) {
+                for id in c * CHUNK..((c + 1) * CHUNK).min(cells.len()) {
+                    let (side, a, centroid) = cells[id];
+                    let nearest = self.index.nearest(self.samples, side, centroid);
+                    if let (None, Some(k)) = (layout.old[id], nearest) {
+                        chunk.shares.push((id as u32, k, a));
+                    }
+                }
+            }
+        }
+        Ok(chunks)
+    }
+
     /// Splits cell `id` of area `a` at `centroid` (2D, on `side`) among the samples of the
     /// side within R of it (eq. 5), into `out`.
     #[allow(clippy::too_many_arguments)]
@@ -384,21 +456,6 @@ fn area_centroid(poly: &[Vec2]) -> Option<(f64, Vec2)> {
     }
     let centroid = o + Vec2::new((cx / twice) as f32, (cy / twice) as f32);
     Some((0.5 * twice.abs(), centroid))
-}
-
-/// Area carried by each side's samples minus the side's area, relative (0 when conserved);
-/// an error if the samples lie on sides `maps` does not have.
-pub fn conservation_error(samples: &Samples, maps: &[SurfaceMap]) -> crate::Result<f64> {
-    let per_side = samples.area_per_side(2 * maps.len())?;
-    Ok(per_side
-        .iter()
-        .enumerate()
-        .filter(|(_, &a)| a > 0.0)
-        .map(|(side, &a)| {
-            let expected = maps[surface_of(side as u32) as usize].area();
-            (a - expected).abs() / expected
-        })
-        .fold(0.0, f64::max))
 }
 
 #[cfg(test)]

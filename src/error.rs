@@ -44,7 +44,7 @@ pub enum Error {
         problem: String,
     },
     /// A worker thread of the solver failed or panicked (in a host's own `Visibility`, say).
-    #[error("solver worker failed: {problem}")]
+    #[error("worker failed: {problem}")]
     Worker {
         /// What happened.
         problem: String,
@@ -61,9 +61,17 @@ pub enum Error {
     /// An option value is out of range or inconsistent.
     #[error("invalid option {option}: {problem}")]
     Option {
-        /// The option's name.
+        /// The option's name, as the options struct spells its field.
         option: &'static str,
         /// What is wrong with its value.
+        problem: String,
+    },
+    /// Work that would need more memory than the budget allows, refused before allocating.
+    #[error("memory budget of {}: {problem}", crate::budget::human_bytes(*budget as f64))]
+    Budget {
+        /// The budget, bytes.
+        budget: usize,
+        /// What would not fit, and how much it needs.
         problem: String,
     },
 }

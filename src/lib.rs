@@ -24,23 +24,27 @@
 //! # Ok::<(), meshlight::Error>(())
 //! ```
 
-pub mod area;
+mod area;
+pub mod budget;
 pub mod error;
 pub mod ies;
-pub mod light;
+mod light;
 pub mod lux;
 pub mod metrics;
 mod parallel;
 pub mod ply;
+pub mod progress;
 pub mod reference;
 pub mod render;
-pub mod sampling;
+mod sampling;
 pub mod scene;
 pub mod solver;
 pub mod visibility;
 
 pub use error::{Error, Result};
+pub use light::MAX_LIGHT_SAMPLES;
+pub use progress::{Control, Phase, Progress};
 pub use render::{render, Direct, Image, Quantity, RenderOptions};
 pub use scene::Scene;
-pub use solver::{solve, Options, Solution};
+pub use solver::{solve, Options, Preset, Solution};
 pub use visibility::{Backend, Visibility};

@@ -13,7 +13,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use crate::error::Result;
-use crate::parallel::for_chunks_reporting;
+use crate::parallel::{for_chunks_reporting, Report};
 use crate::sampling::poisson::side_seed;
 use crate::scene::{PointSource, Scene};
 use crate::visibility::{Segment, Visibility};
@@ -99,17 +99,6 @@ impl DirectLight {
         }
     }
 
-    /// Whether the scene has any light at all.
-    pub fn is_dark(&self) -> bool {
-        self.emitters.iter().all(|e| e.ke.max_element() <= 0.0)
-            && self.points.iter().all(|s| {
-                s.intensity.max_element() <= 0.0
-                    || s.luminaire
-                        .as_ref()
-                        .is_some_and(|l| l.photometry.flux() <= 0.0)
-            })
-    }
-
     /// Shadow rays one receiver may cast (for progress and query counts).
     pub fn rays_per_receiver(&self) -> usize {
         self.points.len() + self.emitters.len() * self.light_samples as usize
@@ -117,7 +106,8 @@ impl DirectLight {
 
     /// Direct light at each (position, normal); receiver i draws its shadow rays from a seed
     /// derived from (`seed`, `ids[i]`), so answers do not depend on batching or threads.
-    /// `report` hears the share done now and then.
+    /// `report` hears the share done now and then; after a Stop the receivers not reached yet
+    /// are left dark.
     pub fn at(
         &self,
         vis: &dyn Visibility,
@@ -125,7 +115,7 @@ impl DirectLight {
         ids: &[u32],
         seed: u64,
         threads: usize,
-        report: &mut dyn FnMut(f64),
+        report: Report,
     ) -> Result<(Vec<Arrival>, u64)> {
         let mut out = vec![Arrival::default(); points.len()];
         let queries = std::sync::atomic::AtomicU64::new(0);

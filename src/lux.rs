@@ -9,8 +9,9 @@
 use glam::{DVec3, Vec3};
 
 use crate::error::Result;
-use crate::light::DirectLight;
+use crate::light::{Arrival, DirectLight};
 use crate::parallel::for_chunks_reporting;
+use crate::progress::{Callback, Phase, Progress, Reporter};
 use crate::scene::{Grid, Scene};
 use crate::solver::Solution;
 use crate::visibility::{Segment, Visibility};
@@ -36,16 +37,30 @@ impl Default for LuxOptions {
     }
 }
 
-/// Illuminance (RGB; W/m², or lux in a photometric scene) at each of `grid`'s points, in
-/// [`Grid::points`] order: direct + inter-reflected. `progress` hears the share done.
+/// What a grid measured.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct Illuminance {
+    /// Illuminance (RGB; W/m², or lux in a photometric scene) at each of the grid's points, in
+    /// [`Grid::points`] order: direct + inter-reflected.
+    pub values: Vec<DVec3>,
+    /// How many points, from the first, are measured in full: all of them unless the host
+    /// stopped the call (the others then hold their direct light, or 0 if the stop came
+    /// before it).
+    pub measured: usize,
+}
+
+/// Measures the illuminance at `grid`'s points (see the module doc). `progress` hears the
+/// direct light's and the gather's share done (phases [`Phase::DirectLight`] and
+/// [`Phase::Gathering`]) and may stop the call.
 pub fn illuminance(
     scene: &Scene,
     solution: &Solution,
     vis: &dyn Visibility,
     grid: &Grid,
     options: &LuxOptions,
-    progress: &mut dyn FnMut(f64),
-) -> Result<Vec<DVec3>> {
+    progress: Callback,
+) -> Result<Illuminance> {
     crate::parallel::guarded("the illuminance gather", || {
         solution.check_fits(scene)?;
         if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&options.light_samples) {
@@ -60,21 +75,29 @@ pub fn illuminance(
         }
         let points = grid.points();
         let n = grid.normal;
+        let mut reporter = Reporter::new(progress);
+        let base = Progress {
+            items: points.len(),
+            ..Progress::of(Phase::DirectLight)
+        };
         // Direct light: the solver's estimator at the points, facing the grid's normal.
         let light = DirectLight::new(scene, options.light_samples);
         let at: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, n)).collect();
         let ids: Vec<u32> = (0..points.len() as u32).collect();
-        let (direct, _) = light.at(vis, &at, &ids, options.seed, options.threads, &mut |f| {
-            progress(0.2 * f)
-        })?;
+        let (direct, _) = if reporter.report(base) {
+            (vec![Arrival::default(); points.len()], 0)
+        } else {
+            let part = &mut reporter.part(base);
+            light.at(vis, &at, &ids, options.seed, options.threads, part)?
+        };
         // Inter-reflected light from every sample.
         let s = &solution.samples;
         let reflected: Vec<DVec3> = (0..s.len())
             .map(|k| solution.radiosity[k] - crate::solver::emission_of(scene, s, k))
             .collect();
         let lift = crate::visibility::lift(scene);
-        let mut gathered = vec![DVec3::ZERO; points.len()];
-        let gather = |first: usize, out: &mut [DVec3]| {
+        let mut gathered: Vec<Option<DVec3>> = vec![None; points.len()];
+        let gather = |first: usize, out: &mut [Option<DVec3>]| {
             for (o, &x) in out.iter_mut().zip(&points[first..]) {
                 let mut segments = Vec::new();
                 let mut shares = Vec::new();
@@ -104,23 +127,37 @@ pub fn illuminance(
                 }
                 let mut blocked = vec![false; segments.len()];
                 vis.occluded(&segments, &mut blocked)?;
-                *o = shares
-                    .iter()
-                    .zip(&blocked)
-                    .filter(|(_, &b)| !b)
-                    .map(|(e, _)| *e)
-                    .sum();
+                *o = Some(
+                    shares
+                        .iter()
+                        .zip(&blocked)
+                        .filter(|(_, &b)| !b)
+                        .map(|(e, _)| *e)
+                        .sum(),
+                );
             }
             Ok(())
         };
-        for_chunks_reporting(&mut gathered, 4, options.threads, gather, &mut |f| {
-            progress(0.2 + 0.8 * f)
-        })?;
-        Ok(direct
+        let base = Progress {
+            phase: Phase::Gathering,
+            ..base
+        };
+        let measured = if reporter.report(base) {
+            0
+        } else {
+            let part = &mut reporter.part(base);
+            match for_chunks_reporting(&mut gathered, 4, options.threads, gather, part)? {
+                true => points.len(),
+                // Parts are done in order: the measured points are those with a gather.
+                false => gathered.iter().take_while(|g| g.is_some()).count(),
+            }
+        };
+        let values = direct
             .iter()
             .zip(&gathered)
-            .map(|(d, g)| d.irradiance + *g)
-            .collect())
+            .map(|(d, g)| d.irradiance + g.unwrap_or(DVec3::ZERO))
+            .collect();
+        Ok(Illuminance { values, measured })
     })
 }
 

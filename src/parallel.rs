@@ -8,6 +8,7 @@ use std::sync::Mutex;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use crate::error::{Error, Result};
+use crate::progress::Control;
 
 /// Runs `f`, turning a panic (in a host's own `Visibility`, say) into [`Error::Worker`] naming
 /// `what` and the panic's message: a host must never be taken down by the library.
@@ -71,18 +72,19 @@ pub(crate) fn for_chunks<T: Send>(
 }
 
 /// How a long parallel job tells its caller how far it has got: the share done, in [0, 1],
-/// called on the calling thread between parts of the work.
-pub(crate) type Report<'a> = &'a mut dyn FnMut(f64);
+/// called on the calling thread between parts of the work; the answer says whether to go on.
+pub(crate) type Report<'a> = &'a mut dyn FnMut(f64) -> Control;
 
 /// [`for_chunks`] in about `PARTS` parts, with `report` after each. Part boundaries fall on chunk
-/// boundaries, so the chunks and their results are the same as one call's.
+/// boundaries, so the chunks and their results are the same as one call's. Whether every part
+/// was done: a [`Control::Stop`] leaves the parts after it untouched.
 pub(crate) fn for_chunks_reporting<T: Send>(
     out: &mut [T],
     chunk: usize,
     threads: usize,
     f: impl Fn(usize, &mut [T]) -> Result<()> + Sync,
     report: Report,
-) -> Result<()> {
+) -> Result<bool> {
     const PARTS: usize = 20;
     let chunk = chunk.max(1);
     let total = out.len();
@@ -92,9 +94,11 @@ pub(crate) fn for_chunks_reporting<T: Send>(
         let len = piece.len();
         for_chunks(piece, chunk, threads, |i, c| f(done + i, c))?;
         done += len;
-        report(done as f64 / total.max(1) as f64);
+        if report(done as f64 / total.max(1) as f64) == Control::Stop && done < total {
+            return Ok(false);
+        }
     }
-    Ok(())
+    Ok(true)
 }
 
 #[cfg(test)]
@@ -115,11 +119,39 @@ mod tests {
             let (mut a, mut b) = (vec![0u64; 10_007], vec![0u64; 10_007]);
             for_chunks(&mut a, 64, threads, f).unwrap();
             let mut reports = Vec::new();
-            for_chunks_reporting(&mut b, 64, threads, f, &mut |x| reports.push(x)).unwrap();
+            let all = for_chunks_reporting(&mut b, 64, threads, f, &mut |x| {
+                reports.push(x);
+                Control::Continue
+            });
+            assert!(all.unwrap());
             assert_eq!(a, b);
             assert!(reports.windows(2).all(|w| w[0] < w[1]), "{reports:?}");
             assert_eq!(reports.last(), Some(&1.0));
             assert!(reports.len() >= 10, "{}", reports.len());
         }
+    }
+
+    #[test]
+    fn a_stop_leaves_the_later_parts_untouched() {
+        let mut out = vec![0u32; 1000];
+        let mut reports = 0;
+        let all = for_chunks_reporting(
+            &mut out,
+            10,
+            2,
+            |_, c| {
+                c.fill(1);
+                Ok(())
+            },
+            &mut |_| {
+                reports += 1;
+                Control::Stop
+            },
+        );
+        assert!(!all.unwrap());
+        assert_eq!(reports, 1);
+        let done = out.iter().filter(|&&x| x == 1).count();
+        assert_eq!(done, 50, "one part of the twenty");
+        assert!(out[done..].iter().all(|&x| x == 0));
     }
 }

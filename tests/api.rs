@@ -53,8 +53,14 @@ fn a_solution_of_another_scene_is_refused() {
     let (cube, room) = (box_scene(), Scene::load(shipped("room")).unwrap());
     let solution = solve(&cube);
     let vis = Backend::Bvh.build(&room).unwrap();
-    let e =
-        meshlight::render(&room, &solution, vis.as_ref(), &RenderOptions::default()).unwrap_err();
+    let e = meshlight::render(
+        &room,
+        &solution,
+        vis.as_ref(),
+        &RenderOptions::default(),
+        &mut |_| meshlight::Control::Continue,
+    )
+    .unwrap_err();
     assert!(
         e.to_string()
             .contains("solved for 6 surfaces, the scene has 17"),
@@ -63,12 +69,19 @@ fn a_solution_of_another_scene_is_refused() {
     let e = transfer(&room, &solution, vis.as_ref(), &[0], DVec3::ONE).unwrap_err();
     assert!(matches!(e, Error::Argument { .. }), "{e}");
 
-    // Edited by the host: a sample's arrays no longer agree.
-    let mut edited = solution.clone();
-    edited.radiosity.pop();
-    let vis = Backend::Bvh.build(&cube).unwrap();
-    let e = meshlight::render(&cube, &edited, vis.as_ref(), &RenderOptions::default()).unwrap_err();
-    assert!(e.to_string().contains("radiosities for"), "{e}");
+    // A solution of the same scene at another scale is refused too: every count agrees, the
+    // samples do not lie on the surfaces.
+    let bigger = cube.scaled(2.0).unwrap();
+    let vis = Backend::Bvh.build(&bigger).unwrap();
+    let e = meshlight::render(
+        &bigger,
+        &solution,
+        vis.as_ref(),
+        &RenderOptions::default(),
+        &mut |_| meshlight::Control::Continue,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("does not lie on surface"), "{e}");
 }
 
 #[test]
@@ -76,17 +89,17 @@ fn indexes_out_of_range_are_errors() {
     let cube = box_scene();
     let solution = solve(&cube);
     let vis = Backend::Bvh.build(&cube).unwrap();
-    let n = solution.samples.len() as u32;
+    let n = solution.samples().len() as u32;
     let e = transfer(&cube, &solution, vis.as_ref(), &[0, n], DVec3::ONE).unwrap_err();
     assert!(
         e.to_string()
             .contains(&format!("sample {n} does not exist")),
         "{e}"
     );
-    let e = solution.samples.area_per_side(3).unwrap_err();
+    let e = solution.samples().area_per_side(3).unwrap_err();
     assert!(matches!(e, Error::Argument { .. }), "{e}");
     // Enough sides: the areas add up to the cube's 6 m² (each face's area is conserved).
-    let total: f64 = solution.samples.area_per_side(12).unwrap().iter().sum();
+    let total: f64 = solution.samples().area_per_side(12).unwrap().iter().sum();
     assert!((total - 6.0).abs() < 1e-3, "{total}");
 }
 
@@ -110,7 +123,7 @@ fn scaling_by_nonsense_is_an_error() {
 fn shadow_ray_counts_out_of_range_are_errors() {
     let cube = box_scene();
     let vis = Backend::Bvh.build(&cube).unwrap();
-    let max = meshlight::light::MAX_LIGHT_SAMPLES;
+    let max = meshlight::MAX_LIGHT_SAMPLES;
     for light_samples in [0, max + 1, u32::MAX] {
         let options = Options {
             light_samples,
@@ -126,18 +139,20 @@ fn shadow_ray_counts_out_of_range_are_errors() {
             direct: meshlight::Direct::Traced { light_samples },
             ..RenderOptions::default()
         };
-        let e = meshlight::render(&cube, &solution, vis.as_ref(), &options).unwrap_err();
+        let e = meshlight::render(&cube, &solution, vis.as_ref(), &options, &mut |_| {
+            meshlight::Control::Continue
+        })
+        .unwrap_err();
         assert!(matches!(e, Error::Argument { .. }), "{light_samples}: {e}");
-        let grid = meshlight::scene::Grid {
-            name: "g".into(),
-            origin: Vec3::splat(0.4),
-            u: Vec3::X * 0.2,
-            v: Vec3::Z * 0.2,
-            normal: Vec3::Y,
-            spacing: 0.1,
-            n_u: 2,
-            n_v: 2,
-        };
+        let grid = meshlight::scene::Grid::new(
+            "g",
+            Vec3::splat(0.4),
+            Vec3::X * 0.2,
+            Vec3::Z * 0.2,
+            Some(Vec3::Y),
+            Some(0.1),
+        )
+        .unwrap();
         let options = meshlight::lux::LuxOptions {
             light_samples,
             ..Default::default()
@@ -148,7 +163,7 @@ fn shadow_ray_counts_out_of_range_are_errors() {
             vis.as_ref(),
             &grid,
             &options,
-            &mut |_| {},
+            &mut |_| meshlight::Control::Continue,
         )
         .unwrap_err();
         assert!(matches!(e, Error::Argument { .. }), "{light_samples}: {e}");
@@ -230,7 +245,10 @@ fn a_backend_that_panics_ends_the_solve_with_an_error_not_a_hang() {
             threads,
             ..RenderOptions::default()
         };
-        let e = meshlight::render(&cube, &solution, &vis, &options).unwrap_err();
+        let e = meshlight::render(&cube, &solution, &vis, &options, &mut |_| {
+            meshlight::Control::Continue
+        })
+        .unwrap_err();
         assert!(e.to_string().contains("broke on call 5"), "{e}");
     }
 }

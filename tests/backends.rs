@@ -31,7 +31,7 @@ fn check(scene: &Scene) {
     let occ_b = occluded_all(&bvh, &segments, 2).unwrap();
     let blocked = occ_e.iter().filter(|&&b| b).count();
     assert!(
-        blocked > 0 || scene.triangles.len() < 20,
+        blocked > 0 || scene.triangles().len() < 20,
         "some segments are blocked: {blocked}"
     );
     let differ: Vec<usize> = (0..segments.len())
@@ -40,7 +40,7 @@ fn check(scene: &Scene) {
     assert!(
         differ.len() as f64 <= 1e-5 * segments.len() as f64,
         "{}: {} of {} occlusion answers differ, e.g.:\n{}",
-        scene.path.display(),
+        scene.path().display(),
         differ.len(),
         segments.len(),
         list_segments(&differ, &segments, &occ_e)
@@ -62,7 +62,7 @@ fn check(scene: &Scene) {
     assert!(
         bad.len() as f64 <= 1e-5 * rays.len() as f64,
         "{}: {} of {} closest hits differ, e.g.:\n{}",
-        scene.path.display(),
+        scene.path().display(),
         bad.len(),
         rays.len(),
         list_rays(&bad, &rays, &hit_e, &hit_b)
@@ -131,7 +131,7 @@ fn both_backends_see_the_known_answer_through_the_room() {
         let hit = hit[0].unwrap_or_else(|| panic!("{} missed the back wall", vis.name()));
         assert!((hit.t - 8.9).abs() < 1e-5, "{}: t = {}", vis.name(), hit.t);
         assert_eq!(
-            scene.triangles[hit.triangle as usize].normal,
+            scene.triangles()[hit.triangle as usize].normal,
             glam::Vec3::NEG_Z
         );
         let mut blocked = [true, false];

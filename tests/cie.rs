@@ -38,7 +38,7 @@ fn a_closed_room_of_uniform_reflectance_receives_flux_over_s_times_one_minus_rho
             Vec3::new(2.0, 1.5, 5.0),
             8,
         ));
-        let area: f64 = scene.surfaces.iter().map(|s| s.area).sum();
+        let area: f64 = scene.surfaces().iter().map(|s| s.area).sum();
         // S: the room's 94 m² and the pillar's four sides 0.6 × 3 (the test's own check).
         let s_by_hand = 2.0 * (4.0 * 3.0 + 4.0 * 5.0 + 3.0 * 5.0) + 4.0 * 0.6 * 3.0;
         assert!((area - s_by_hand).abs() < 1e-3, "{area} vs {s_by_hand}");
@@ -50,10 +50,10 @@ fn a_closed_room_of_uniform_reflectance_receives_flux_over_s_times_one_minus_rho
                 ..Options::default()
             };
             let s = solve(&scene, backend, options);
-            let mean = (0..s.samples.len())
-                .map(|k| s.irradiance[k].y * s.samples.area[k])
+            let mean = (0..s.samples().len())
+                .map(|k| s.irradiance()[k].y * s.samples().area()[k])
                 .sum::<f64>()
-                / s.samples.area.iter().sum::<f64>();
+                / s.samples().area().iter().sum::<f64>();
             let error = mean / want - 1.0;
             eprintln!(
                 "ρ {rho}, {backend}: mean irradiance {mean:.5} vs Φ/(S(1 − ρ)) {want:.5}: {:+.2}%",

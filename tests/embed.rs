@@ -30,8 +30,8 @@ fn a_host_with_its_own_ray_caster_gets_what_the_shipped_backends_give() {
         let vis = backend.build(&scene).unwrap();
         let theirs = embed::run(&scene, vis.as_ref(), 10).unwrap();
         assert_eq!(
-            theirs.solution.samples.len(),
-            stopped.solution.samples.len()
+            theirs.solution.samples().len(),
+            stopped.solution.samples().len()
         );
         let e = meshlight::metrics::compare(&stopped.image, &theirs.image).unwrap();
         assert!(

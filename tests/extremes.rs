@@ -14,7 +14,7 @@ fn solve(scene: &Scene, options: &Options) -> (Solution, Image) {
     let (solution, image) =
         common::solve_and_render(scene, Backend::default_backend(), options.clone(), true);
     assert!(
-        solution.radiosity.iter().all(|b| b.is_finite()),
+        solution.radiosity().iter().all(|b| b.is_finite()),
         "radiosity is finite"
     );
     assert!(
@@ -36,7 +36,11 @@ fn relative_difference(a: &Image, b: &Image, factor: f64) -> f64 {
 #[test]
 fn albedo_099_converges_to_ke_over_one_minus_rho() {
     let mut scene = Scene::load(shipped("box")).unwrap();
-    scene.materials[0].kd = Vec3::splat(0.99);
+    {
+        let mut m = scene.materials()[0].clone();
+        m.kd = Vec3::splat(0.99);
+        scene.set_material(0, m).unwrap();
+    }
     let options = Options {
         tolerance: 1e-4,
         max_shots: Some(2_000_000),
@@ -45,7 +49,7 @@ fn albedo_099_converges_to_ke_over_one_minus_rho() {
     let (s, image) = solve(&scene, &options);
     assert_eq!(s.stop(), StopReason::Converged);
     let expected = 0.1 / (1.0 - 0.99f64);
-    for b in &s.radiosity {
+    for b in s.radiosity() {
         let l = b.x / std::f64::consts::PI;
         assert!(
             (l - expected).abs() < 0.01 * expected,
@@ -63,7 +67,11 @@ fn albedo_099_converges_to_ke_over_one_minus_rho() {
 #[test]
 fn albedo_099_with_few_shots_stops_and_says_how_much_is_left() {
     let mut scene = Scene::load(shipped("box")).unwrap();
-    scene.materials[0].kd = Vec3::splat(0.99);
+    {
+        let mut m = scene.materials()[0].clone();
+        m.kd = Vec3::splat(0.99);
+        scene.set_material(0, m).unwrap();
+    }
     // The flat solver's shots are single samples; the hierarchy's, sweeps of all of them.
     for (threshold, shots) in [(0.0, 5_000), (Options::default().cluster_threshold, 50)] {
         let options = Options {
@@ -74,30 +82,30 @@ fn albedo_099_with_few_shots_stops_and_says_how_much_is_left() {
         };
         let (s, _) = solve(&scene, &options);
         assert_eq!(s.stop(), StopReason::ShotLimit);
-        let left = s.rounds[0].shooting.unshot_fraction;
+        let left = s.rounds()[0].shooting.unshot_fraction;
         assert!(
             left > options.tolerance && left.is_finite(),
             "unshot fraction {left}"
         );
         // What was shot is a lower bound: below the converged answer, above the direct light.
-        let l = s.radiosity[0].x / std::f64::consts::PI;
+        let l = s.radiosity()[0].x / std::f64::consts::PI;
         assert!(l > 0.1 * 1.99 && l < 10.0, "{l}");
         // And what is left is told right: unshot radiosity U still brings ρU + ρ²U + … =
         // U·ρ/(1 − ρ), so B + 99·U (area-weighted means) is the converged π·Ke/(1 − ρ) = 10π.
-        let area: f64 = s.samples.area.iter().sum();
+        let area: f64 = s.samples().area().iter().sum();
         let mean = |v: &[glam::DVec3]| {
             v.iter()
-                .zip(&s.samples.area)
+                .zip(s.samples().area())
                 .map(|(b, a)| b.x * a)
                 .sum::<f64>()
                 / area
         };
-        let predicted = (mean(&s.radiosity) + 99.0 * mean(&s.unshot)) / std::f64::consts::PI;
+        let predicted = (mean(s.radiosity()) + 99.0 * mean(s.unshot())) / std::f64::consts::PI;
         assert!(
             (predicted - 10.0).abs() < 0.02 * 10.0,
             "threshold {threshold}: shot {:.3} + left {:.3} = {predicted:.3}, not 10",
-            mean(&s.radiosity) / std::f64::consts::PI,
-            99.0 * mean(&s.unshot) / std::f64::consts::PI
+            mean(s.radiosity()) / std::f64::consts::PI,
+            99.0 * mean(s.unshot()) / std::f64::consts::PI
         );
     }
 }
@@ -106,14 +114,18 @@ fn albedo_099_with_few_shots_stops_and_says_how_much_is_left() {
 fn brighter_walls_give_a_brighter_room() {
     let base = Scene::load(shipped("room")).unwrap();
     let white = base
-        .materials
+        .materials()
         .iter()
         .position(|m| m.name == "white")
         .unwrap();
     let mut means = Vec::new();
     for kd in [0.725, 0.85, 0.95] {
         let mut scene = base.clone();
-        scene.materials[white].kd = Vec3::splat(kd);
+        {
+            let mut m = scene.materials()[white].clone();
+            m.kd = Vec3::splat(kd);
+            scene.set_material(white, m).unwrap();
+        }
         let (s, image) = solve(
             &scene,
             &Options {
@@ -167,7 +179,7 @@ fn one_sample_per_surface_still_gives_a_plausible_image() {
         },
     );
     // One sample per reflecting side (the light reflects nothing: no sample).
-    assert_eq!(s.samples.len(), 16);
+    assert_eq!(s.samples().len(), 16);
     let ratio = coarse.mean() / fine.mean();
     assert!(
         ratio > 0.5 && ratio < 2.0,
@@ -215,9 +227,9 @@ fn nearly_coincident_facing_samples_transfer_finitely() {
         16,
     ));
     let (s, _) = solve(&scene, &Options::default());
-    assert!(s.radiosity.iter().all(|b| b.is_finite()));
+    assert!(s.radiosity().iter().all(|b| b.is_finite()));
     assert!(
-        s.radiosity.iter().any(|b| b.x > 0.0),
+        s.radiosity().iter().any(|b| b.x > 0.0),
         "the upper face is lit"
     );
 }
@@ -271,11 +283,11 @@ fn degenerate_geometry_is_survived() {
     ));
     assert!(
         scene
-            .warnings
+            .warnings()
             .iter()
             .any(|w| w.contains("dropped 1 zero-area triangle")),
         "{:?}",
-        scene.warnings
+        scene.warnings()
     );
     let (s, image) = solve(&scene, &Options::default());
     assert_eq!(s.stop(), StopReason::Converged);
@@ -301,10 +313,10 @@ fn a_lone_triangle_and_a_light_with_nothing_to_light() {
         16,
     ));
     let (s, image) = solve(&scene, &Options::default());
-    assert!(s.radiosity.iter().all(|b| *b == DVec3::ZERO));
+    assert!(s.radiosity().iter().all(|b| *b == DVec3::ZERO));
     assert_eq!(image.mean(), 0.0);
     // The light's power all escapes.
-    assert!((s.ledger.escaped.x - s.ledger.emitted.x).abs() < 1e-9 * s.ledger.emitted.x);
+    assert!((s.ledger().escaped.x - s.ledger().emitted.x).abs() < 1e-9 * s.ledger().emitted.x);
 }
 
 #[test]

@@ -35,12 +35,12 @@ fn points_are_cell_centres_and_the_default_spacing_follows_en_12464() {
         "[[grid]]\nname = \"work plane\"\norigin = [0.5, 0.8, 0.5]\nu = [0, 0, 7]\nv = [4.5, 0, 0]",
     )
     .unwrap();
-    let g = &scene.grids[0];
+    let g = &scene.grids()[0];
     // p = 0.2 · 5^log10(7) = 0.2 · 3.8965 = 0.7793: ⌈7 / 0.7793⌉ = 9, ⌈4.5 / 0.7793⌉ = 6.
-    assert!((g.spacing - 0.7793).abs() < 1e-4, "{}", g.spacing);
-    assert_eq!((g.n_u, g.n_v), (9, 6));
+    assert!((g.spacing() - 0.7793).abs() < 1e-4, "{}", g.spacing());
+    assert_eq!(g.counts_uv(), (9, 6));
     // Facing u × v = (0, 0, 7) × (4.5, 0, 0) = (0, 31.5, 0): up.
-    assert_eq!(g.normal, Vec3::Y);
+    assert_eq!(g.normal(), Vec3::Y);
     let p = g.points();
     assert_eq!(p.len(), 54);
     // The first cell's centre: origin + u/18 + v/12; the last: origin + 17u/18 + 11v/12.
@@ -58,14 +58,8 @@ fn points_are_cell_centres_and_the_default_spacing_follows_en_12464() {
         "{}",
         p[53]
     );
-    assert_eq!(
-        Grid {
-            name: "a b/c".into(),
-            ..g.clone()
-        }
-        .file_stem(),
-        "a_b_c"
-    );
+    let named = Grid::new("a b/c", Vec3::ZERO, Vec3::X, Vec3::Z, None, None).unwrap();
+    assert_eq!(named.file_stem(), "a_b_c");
 }
 
 #[test]
@@ -122,11 +116,12 @@ fn measure(scene: &Scene, backend: meshlight::Backend, options: &Options) -> Vec
         scene,
         &s,
         vis.as_ref(),
-        &scene.grids[0],
+        &scene.grids()[0],
         &LuxOptions::default(),
-        &mut |_| {},
+        &mut |_| meshlight::Control::Continue,
     )
     .unwrap()
+    .values
 }
 
 #[test]
@@ -136,7 +131,7 @@ fn under_a_downlight_a_grid_measures_i_of_gamma_cos_over_r_squared() {
         "[[luminaire]]\nies = \"down.ies\"\nposition = [0, 3, 0]\n\n[[grid]]\nname = \"g\"\norigin = [-3, 1, -3]\nu = [6, 0, 0]\nv = [0, 0, 6]\nnormal = [0, 1, 0]\nspacing = 1",
     )
     .unwrap();
-    let points = scene.grids[0].points();
+    let points = scene.grids()[0].points();
     for backend in backends() {
         let e = measure(
             &scene,
@@ -228,17 +223,17 @@ fn points_inside_a_solid_are_found_and_left_out() {
         &["+y"],
     );
     let mut scene = b.scene(common::camera(Vec3::new(0.0, 3.0, -6.0), Vec3::ZERO, 8));
-    scene.grids.push(Grid {
-        name: "through the cube".into(),
-        origin: Vec3::new(-2.0, 0.5, -2.0),
-        u: Vec3::new(4.0, 0.0, 0.0),
-        v: Vec3::new(0.0, 0.0, 4.0),
-        normal: Vec3::Y,
-        spacing: 0.5,
-        n_u: 8,
-        n_v: 8,
-    });
-    let grid = &scene.grids[0];
+    let through = Grid::new(
+        "through the cube",
+        Vec3::new(-2.0, 0.5, -2.0),
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 4.0),
+        Some(Vec3::Y),
+        Some(0.5),
+    )
+    .unwrap();
+    scene.add_grid(through).unwrap();
+    let grid = &scene.grids()[0];
     for backend in backends() {
         let vis = backend.build(&scene).unwrap();
         let inside = meshlight::lux::enclosed(&scene, vis.as_ref(), grid).unwrap();

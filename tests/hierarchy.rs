@@ -23,7 +23,7 @@ fn room_at_the_default_threshold_is_within_half_a_percent_of_the_flat_solve() {
         let (_, reference) = solve_and_render(&scene, backend, flat(), true);
         let (solution, image) = solve_and_render(&scene, backend, Options::default(), true);
         assert!(solution
-            .rounds
+            .rounds()
             .iter()
             .all(|r| r.shooting.links > 0 || r.shooting.shots == 0));
         let e = meshlight::metrics::compare(&image, &reference).unwrap();
@@ -49,7 +49,7 @@ fn furnace_holds_with_the_hierarchy_and_without_it() {
             let (s, image) = solve_and_render(&scene, backend, options, true);
             assert_eq!(s.stop(), StopReason::Converged);
             let worst_sample = s
-                .radiosity
+                .radiosity()
                 .iter()
                 .map(|b| (b.x / std::f64::consts::PI - 0.2).abs() / 0.2)
                 .fold(0.0, f64::max);
@@ -68,9 +68,9 @@ fn furnace_holds_with_the_hierarchy_and_without_it() {
             // solver (measured 0.997..1.013). The hierarchy's receiver field is first order,
             // and a tangent overestimates a concave field: at face centres, where irradiance
             // peaks, rows reach 1.021 (median 1.008), hence 2.5% for it.
-            let closed: Vec<usize> = (0..s.samples.len()).filter(|&k| s.closed()[k]).collect();
+            let closed: Vec<usize> = (0..s.samples().len()).filter(|&k| s.closed()[k]).collect();
             assert!(
-                closed.len() > s.samples.len() * 9 / 10,
+                closed.len() > s.samples().len() * 9 / 10,
                 "{} closed",
                 closed.len()
             );
@@ -100,7 +100,7 @@ fn no_light_goes_through_a_wall_at_the_default_threshold_or_a_hundred_times_it()
                 ..Options::default()
             };
             let (s, image) = solve_and_render(&scene, backend, options, true);
-            let shooting = &s.rounds[0].shooting;
+            let shooting = s.rounds()[0].shooting;
             assert!(
                 shooting.links > shooting.leaf_links,
                 "{backend}: the hierarchy made cluster links"
@@ -128,7 +128,7 @@ fn queries(scene: &Scene, epsilon: f32, threshold: f64) -> (u64, usize) {
             ..Options::default()
         },
     );
-    (s.rounds[0].shooting.queries, s.samples.len())
+    (s.rounds()[0].shooting.queries, s.samples().len())
 }
 
 #[test]
@@ -179,22 +179,22 @@ fn one_or_two_workers_and_any_pipeline_capacity_give_the_same_answer() {
         meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap()
     };
     let reference = run(1, 16);
-    assert!(reference.rounds[0].shooting.links > 0);
+    assert!(reference.rounds()[0].shooting.links > 0);
     for (threads, capacity) in [(2, 16), (2, 1), (1, 1), (3, 2)] {
         let other = run(threads, capacity);
-        assert_eq!(other.samples, reference.samples);
+        assert_eq!(other.samples(), reference.samples());
         assert!(
-            other.radiosity == reference.radiosity,
+            other.radiosity() == reference.radiosity(),
             "{threads} workers, capacity {capacity}: radiosity differs"
         );
         assert_eq!(
             other
-                .rounds
+                .rounds()
                 .iter()
                 .map(|r| r.shooting.links)
                 .collect::<Vec<_>>(),
             reference
-                .rounds
+                .rounds()
                 .iter()
                 .map(|r| r.shooting.links)
                 .collect::<Vec<_>>()

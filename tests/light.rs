@@ -4,7 +4,10 @@ mod common;
 
 use common::{backends, material, Builder};
 use glam::Vec3;
-use meshlight::light::DirectLight;
+use meshlight::lux::{illuminance, LuxOptions};
+use meshlight::scene::Grid;
+use meshlight::solver::{Control, Options};
+use meshlight::Scene;
 
 #[test]
 fn half_a_light_hidden_gives_half_its_light_with_little_spread() {
@@ -42,27 +45,69 @@ fn half_a_light_hidden_gives_half_its_light_with_little_spread() {
         ],
         floor,
     );
-    let scene = b.scene(common::camera(Vec3::new(0.0, 0.5, -4.0), Vec3::ZERO, 8));
+    let with_sheet = b.scene(common::camera(Vec3::new(0.0, 0.5, -4.0), Vec3::ZERO, 8));
+    // The same scene without the sheet: the estimator is exact there (polygon irradiance × a
+    // visible share of 1), and with the same seeds the ratio is the visible share.
+    let mut open = Builder::default();
+    let lamp = open.material(material("lamp", 0.0, 1.0));
+    let floor = open.material(material("floor", 0.5, 0.0));
+    open.quad(
+        [
+            Vec3::new(-1.0, 2.0, -1.0),
+            Vec3::new(1.0, 2.0, -1.0),
+            Vec3::new(1.0, 2.0, 1.0),
+            Vec3::new(-1.0, 2.0, 1.0),
+        ],
+        lamp,
+    );
+    open.quad(
+        [
+            Vec3::new(-3.0, 0.0, -3.0),
+            Vec3::new(-3.0, 0.0, 3.0),
+            Vec3::new(3.0, 0.0, 3.0),
+            Vec3::new(3.0, 0.0, -3.0),
+        ],
+        floor,
+    );
+    let open = open.scene(common::camera(Vec3::new(0.0, 0.5, -4.0), Vec3::ZERO, 8));
     let rays = 16;
-    let light = DirectLight::new(&scene, rays);
-    // 400 receivers along x = 0, each with its own shadow rays.
-    let points: Vec<(Vec3, Vec3)> = (0..400)
-        .map(|i| (Vec3::new(0.0, 0.0, -0.5 + i as f32 / 400.0), Vec3::Y))
-        .collect();
-    let ids: Vec<u32> = (0..400).collect();
+    // 400 receivers along x = 0 on the floor, facing up, each with its own shadow rays. The
+    // floor is behind them, so they measure the direct light alone.
+    let grid = Grid::new(
+        "x = 0",
+        Vec3::new(-0.5e-4, 0.0, -0.5),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(1e-4, 0.0, 0.0),
+        Some(Vec3::Y),
+        Some(1.0 / 400.0),
+    )
+    .unwrap();
+    assert_eq!(grid.counts_uv(), (400, 1));
+    let lux = LuxOptions {
+        light_samples: rays,
+        seed: 7,
+        threads: 2,
+    };
     for backend in backends() {
-        let vis = backend.build(&scene).unwrap();
-        let (arrivals, _) = light
-            .at(vis.as_ref(), &points, &ids, 7, 2, &mut |_| {})
-            .unwrap();
-        let n = arrivals.len() as f64;
-        let mean = arrivals.iter().map(|a| f64::from(a.visible)).sum::<f64>() / n;
-        let rms = (arrivals
-            .iter()
-            .map(|a| (f64::from(a.visible) - 0.5).powi(2))
-            .sum::<f64>()
-            / n)
-            .sqrt();
+        let measure = |scene: &Scene| {
+            let vis = backend.build(scene).unwrap();
+            let options = Options {
+                rounds: 0,
+                ..Options::default()
+            };
+            let s = meshlight::solve(scene, vis.as_ref(), &options, &mut |_| Control::Continue)
+                .unwrap();
+            illuminance(scene, &s, vis.as_ref(), &grid, &lux, &mut |_| {
+                Control::Continue
+            })
+            .unwrap()
+            .values
+        };
+        let (hidden, full) = (measure(&with_sheet), measure(&open));
+        let visible: Vec<f64> = hidden.iter().zip(&full).map(|(h, f)| h.x / f.x).collect();
+        let n = visible.len() as f64;
+        let mean = visible.iter().sum::<f64>() / n;
+        let rms = (visible.iter().map(|v| (v - 0.5).powi(2)).sum::<f64>() / n).sqrt();
         // Independent rays would spread by √(p(1−p)/N) = 0.125 and leave the mean of 400
         // within 3 × 0.125/20 ≈ 0.019; the estimator must do at least twice as well on both.
         let independent = (0.25f64 / f64::from(rays)).sqrt();

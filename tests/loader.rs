@@ -19,8 +19,8 @@ fn close(a: f64, b: f64) -> bool {
 #[test]
 fn box_is_a_closed_unit_cube_of_six_emitting_faces() {
     let s = scene("box");
-    assert_eq!(s.triangles.len(), 12);
-    assert_eq!(s.surfaces.len(), 6);
+    assert_eq!(s.triangles().len(), 12);
+    assert_eq!(s.surfaces().len(), 6);
     assert!(close(s.total_area(), 6.0), "{}", s.total_area());
     // Every face: Ke 0.1 over 1 m², power π·Ke·A.
     let emitters: Vec<_> = s.emitters().collect();
@@ -30,21 +30,21 @@ fn box_is_a_closed_unit_cube_of_six_emitting_faces() {
     }
     assert!(close(s.emitted_power().y, 6.0 * PI * 0.1));
     // Faces point inwards: every normal points towards the centre.
-    for surface in &s.surfaces {
-        let t = &s.triangles[surface.triangles.start as usize];
+    for surface in s.surfaces() {
+        let t = &s.triangles()[surface.triangles.start as usize];
         let to_centre = glam::Vec3::splat(0.5) - t.vertices[0];
         assert!(surface.normal.dot(to_centre) > 0.0);
         assert!(close(surface.area, 1.0));
     }
-    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
 }
 
 #[test]
 fn room_has_walls_light_and_two_boxes() {
     let s = scene("room");
     // 6 walls + 1 light + 2 boxes × 5 faces (no bottoms), each face a quad of 2 triangles.
-    assert_eq!(s.surfaces.len(), 6 + 1 + 10);
-    assert_eq!(s.triangles.len(), 2 * 17);
+    assert_eq!(s.surfaces().len(), 6 + 1 + 10);
+    assert_eq!(s.triangles().len(), 2 * 17);
     // 5.5 m wide and high, 9 m deep.
     let walls = 4.0 * 5.5 * 9.0 + 2.0 * 5.5 * 5.5;
     let light = 1.2 * 1.2;
@@ -61,13 +61,13 @@ fn room_has_walls_light_and_two_boxes() {
     let (surface, power) = emitters[0];
     assert!(close(power.x, PI * 10.0 * light), "{power}");
     // The light faces down and sits 1 cm under the 5.5 m ceiling.
-    let light_surface = &s.surfaces[surface as usize];
+    let light_surface = &s.surfaces()[surface as usize];
     assert!((light_surface.normal - glam::Vec3::NEG_Y).length() < 1e-6);
     assert!(close(f64::from(-light_surface.offset), 5.49));
-    assert_eq!(s.point_lights.len(), 0);
-    assert_eq!((s.camera.width, s.camera.height), (512, 512));
-    assert_eq!(s.solver.epsilon, Some(0.25));
-    let red = s.materials.iter().find(|m| m.name == "red").unwrap();
+    assert_eq!(s.point_lights().len(), 0);
+    assert_eq!((s.camera().width, s.camera().height), (512, 512));
+    assert_eq!(s.solver_defaults().epsilon, Some(0.25));
+    let red = s.materials().iter().find(|m| m.name == "red").unwrap();
     assert_eq!(red.kd, glam::Vec3::new(0.63, 0.065, 0.05));
 }
 
@@ -76,12 +76,12 @@ fn gallery_is_gallery_scale() {
     let path = meshlight_gallery::ensure().expect("generate the gallery");
     let s = meshlight::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
     assert!(
-        s.triangles.len() >= 100_000,
+        s.triangles().len() >= 100_000,
         "{} triangles",
-        s.triangles.len()
+        s.triangles().len()
     );
-    assert_eq!(s.point_lights.len(), 8);
-    for light in &s.point_lights {
+    assert_eq!(s.point_lights().len(), 8);
+    for light in s.point_lights() {
         assert!(
             light.position.y > 4.0 && light.position.y < 4.5,
             "under the ceiling: {light:?}"
@@ -89,8 +89,8 @@ fn gallery_is_gallery_scale() {
     }
     assert_eq!(s.emitters().count(), 0);
     // 24 m × 16 m × 4.5 m building.
-    assert_eq!(s.bounds.max, glam::Vec3::new(24.0, 4.5, 16.0));
-    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert_eq!(s.bounds().max, glam::Vec3::new(24.0, 4.5, 16.0));
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
 }
 
 #[test]
@@ -98,13 +98,13 @@ fn the_designed_gallery_has_its_luminaires_and_grids() {
     let path = meshlight_gallery::ensure().expect("generate the gallery");
     let design = path.with_file_name("design.toml");
     let s = meshlight::Scene::load(&design).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(s.units, meshlight::scene::Units::Photometric);
-    assert_eq!((s.luminaires.len(), s.grids.len()), (11, 3));
+    assert_eq!(s.units(), meshlight::scene::Units::Photometric);
+    assert_eq!((s.luminaires().len(), s.grids().len()), (11, 3));
     // The downlight was written as I₀ cos³γ for 1,800 lm: Φ = 2π I₀ / 4 (by hand).
-    let flux = s.luminaires[0].flux().y;
+    let flux = s.luminaires()[0].flux().y;
     assert!((flux / 1800.0 - 1.0).abs() < 0.005, "{flux} lm");
     // Grid counts by the spec's rule: 7.8 × 11.7 m at 0.2 · 5^log10(11.7) = 1.1 m → 7 × 11.
-    assert_eq!((s.grids[0].n_u, s.grids[0].n_v), (7, 11));
-    assert_eq!((s.grids[1].n_u, s.grids[1].n_v), (16, 11));
-    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert_eq!(s.grids()[0].counts_uv(), (7, 11));
+    assert_eq!(s.grids()[1].counts_uv(), (16, 11));
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
 }

@@ -48,10 +48,10 @@ fn check(scene: &Scene, expected: impl Fn(Vec3) -> f64) {
         let s =
             meshlight::solve(scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
         let mut worst = 0.0f64;
-        for k in 0..s.samples.len() {
-            let x = s.samples.position[k];
+        for k in 0..s.samples().len() {
+            let x = s.samples().position()[k];
             let want = expected(x);
-            let got = s.direct[k].irradiance;
+            let got = s.direct()[k].irradiance;
             // White light: every channel the same.
             assert!(
                 (got.x - got.y).abs() <= 1e-9 * got.y.abs().max(1.0),
@@ -67,7 +67,7 @@ fn check(scene: &Scene, expected: impl Fn(Vec3) -> f64) {
 #[test]
 fn a_downlight_lights_the_floor_by_i_of_gamma_cos_over_r_squared() {
     let scene = scene("ies = \"down.ies\"\nposition = [1, 2, 0.5]").unwrap();
-    assert_eq!(scene.units, Units::Photometric);
+    assert_eq!(scene.units(), Units::Photometric);
     let light = Vec3::new(1.0, 2.0, 0.5);
     check(&scene, |x| {
         let d = (x - light).as_dvec3();

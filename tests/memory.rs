@@ -6,7 +6,8 @@ mod common;
 
 use common::counting::{self, Counting};
 use common::shipped;
-use meshlight::solver::{Control, Options, BYTES_PER_SAMPLE};
+use meshlight::budget::BYTES_PER_SAMPLE;
+use meshlight::solver::{Control, Options};
 use meshlight::{Backend, Error, Scene};
 
 #[global_allocator]
@@ -60,7 +61,7 @@ fn a_budget_too_small_is_refused_before_allocating_and_names_the_predicted_size(
         ..Options::default()
     };
     let s = solve(&room, &fits).unwrap();
-    let actual = s.rounds[0].solution_bytes as f64;
+    let actual = s.rounds()[0].solution_bytes as f64;
     assert!(
         actual <= samples * BYTES_PER_SAMPLE as f64,
         "{actual} bytes held"
@@ -93,5 +94,5 @@ fn links_that_outgrow_the_budget_end_the_solve_with_an_error_and_within_it_nothi
         solve(&room, &small).unwrap(),
         solve(&room, &Options::default()).unwrap(),
     );
-    assert_eq!(a.radiosity, b.radiosity);
+    assert_eq!(a.radiosity(), b.radiosity());
 }

@@ -11,8 +11,12 @@ use meshlight::{Backend, Scene};
 
 fn small(name: &str, size: u32) -> Scene {
     let mut scene = Scene::load(shipped(name)).unwrap();
-    scene.camera.width = size;
-    scene.camera.height = size;
+    let camera = meshlight::scene::Camera {
+        width: size,
+        height: size,
+        ..scene.camera().clone()
+    };
+    scene.set_camera(camera).unwrap();
     scene
 }
 
@@ -64,7 +68,7 @@ fn halving_the_patches_shrinks_the_change_and_meets_the_path_tracer() {
                 spp: 2048,
                 ..PathOptions::default()
             },
-            &mut |_| {},
+            &mut |_| meshlight::Control::Continue,
         )
         .unwrap();
         assert!(traced.noise < 0.015, "path tracer noise {}", traced.noise);

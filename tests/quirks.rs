@@ -46,9 +46,9 @@ fn load(obj: &str, mtl: &str) -> Scene {
 /// Every surface's (area, reflectance), sorted by area.
 fn surfaces(scene: &Scene) -> Vec<(f64, Vec3)> {
     let mut v: Vec<(f64, Vec3)> = scene
-        .surfaces
+        .surfaces()
         .iter()
-        .map(|s| (s.area, scene.materials[s.material as usize].kd))
+        .map(|s| (s.area, scene.materials()[s.material as usize].kd))
         .collect();
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
     v
@@ -61,12 +61,12 @@ fn close(a: f64, b: f64) -> bool {
 #[test]
 fn white_written_as_one_is_lowered_with_one_warning() {
     let scene = load(OBJ, "newmtl white\nKd 1 1 1\n");
-    let kd = scene.materials[0].kd;
+    let kd = scene.materials()[0].kd;
     // The default the README documents and justifies.
     assert_eq!(kd, Vec3::splat(0.9));
     assert_eq!(DEFAULT_MAX_REFLECTANCE, 0.9);
-    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
-    let w = &scene.warnings[0];
+    assert_eq!(scene.warnings().len(), 1, "{:?}", scene.warnings());
+    let w = &scene.warnings()[0];
     assert!(
         w.starts_with("s.mtl:2: material 'white'") && w.contains("lowered to 0.9"),
         "{w}"
@@ -74,19 +74,19 @@ fn white_written_as_one_is_lowered_with_one_warning() {
 
     // Only the channels at 1 move.
     let scene = load(OBJ, "newmtl white\nKd 1 0.5 0.25\n");
-    assert_eq!(scene.materials[0].kd, Vec3::new(0.9, 0.5, 0.25));
+    assert_eq!(scene.materials()[0].kd, Vec3::new(0.9, 0.5, 0.25));
 
     // The scene file's [solver] max_reflectance, and the caller's over it.
     let toml = format!("{TOML}\n[solver]\nmax_reflectance = 0.8\n");
     let mtl = [("s.mtl", "newmtl white\nKd 1 1 1\n")];
     let scene = load_with(OBJ, &mtl, &toml, &LoadOptions::default()).unwrap();
-    assert_eq!(scene.materials[0].kd, Vec3::splat(0.8));
+    assert_eq!(scene.materials()[0].kd, Vec3::splat(0.8));
     let options = LoadOptions {
         max_reflectance: Some(0.7),
         strict: false,
     };
     let scene = load_with(OBJ, &mtl, &toml, &options).unwrap();
-    assert_eq!(scene.materials[0].kd, Vec3::splat(0.7));
+    assert_eq!(scene.materials()[0].kd, Vec3::splat(0.7));
 }
 
 #[test]
@@ -138,7 +138,7 @@ fn several_mtl_files_on_one_line_are_each_read() {
         close(s[1].0, 2.0) && s[1].1 == Vec3::new(0.6, 0.1, 0.1),
         "{s:?}"
     );
-    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert!(scene.warnings().is_empty(), "{:?}", scene.warnings());
 }
 
 #[test]
@@ -147,11 +147,11 @@ fn a_missing_mtl_file_is_one_warning_and_grey_faces() {
     let scene = load_with(&obj, &[], TOML, &LoadOptions::default()).unwrap();
     assert_eq!(surfaces(&scene), vec![(1.0, Vec3::splat(0.5))]);
     let missing: Vec<&String> = scene
-        .warnings
+        .warnings()
         .iter()
         .filter(|w| w.contains("gone.mtl"))
         .collect();
-    assert_eq!(missing.len(), 1, "{:?}", scene.warnings);
+    assert_eq!(missing.len(), 1, "{:?}", scene.warnings());
     assert!(
         missing[0].starts_with("s.obj:1: MTL file gone.mtl not found"),
         "{}",
@@ -167,9 +167,9 @@ fn byte_order_marks_w_components_negative_indices_and_face_forms() {
                usemtl white\nf -4 -3 -2 -1\nv 2 0 0\nv 3 0 0\nv 3 1 0\nf 5/1 6/1 7/1\nf 5//1 6//1 7//1\nf 5/1/1 6/1/1 7/1/1\n";
     let scene = load(obj, "\u{feff}newmtl white\nKd 0.5 0.5 0.5\n");
     assert!(close(scene.total_area(), 2.5), "{}", scene.total_area());
-    let top = scene.bounds;
+    let top = scene.bounds();
     assert_eq!((top.min, top.max), (Vec3::ZERO, Vec3::new(3.0, 1.0, 0.0)));
-    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert!(scene.warnings().is_empty(), "{:?}", scene.warnings());
 }
 
 #[test]
@@ -183,7 +183,7 @@ fn tabs_crlf_and_texture_options_are_read_through() {
                map_Kd -s 1 1 1 -o 0 0 0 -blendu on wood.png\r\nd 1\r\n";
     let scene = load(&obj, mtl);
     assert_eq!(surfaces(&scene), vec![(1.0, Vec3::new(0.25, 0.5, 0.75))]);
-    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert!(scene.warnings().is_empty(), "{:?}", scene.warnings());
 }
 
 #[test]

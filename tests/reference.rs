@@ -12,14 +12,18 @@ use meshlight::{Backend, Scene};
 
 fn trace(scene: &Scene, backend: Backend, options: PathOptions) -> PathImage {
     let vis = backend.build(scene).unwrap();
-    path_trace(scene, vis.as_ref(), &options, &mut |_| {}).unwrap()
+    path_trace(scene, vis.as_ref(), &options, &mut |_| meshlight::Control::Continue).unwrap()
 }
 
 /// A shipped scene with a smaller image.
 fn small(name: &str, size: u32) -> Scene {
     let mut scene = Scene::load(shipped(name)).unwrap();
-    scene.camera.width = size;
-    scene.camera.height = size;
+    let camera = meshlight::scene::Camera {
+        width: size,
+        height: size,
+        ..scene.camera().clone()
+    };
+    scene.set_camera(camera).unwrap();
     scene
 }
 
@@ -82,7 +86,7 @@ fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
     let scene = builder.scene(camera(Vec3::new(0.0, 3.0, 2.5), Vec3::ZERO, 24));
     // The analytic answer, averaged over each pixel (box filter) on a 16 × 16 grid: the radiance
     // of the plane where the ray lands, Kd/π · I · cosθ / r².
-    let c = &scene.camera;
+    let c = &scene.camera();
     let radiance = |x: f32, y: f32| -> f64 {
         let d = c.direction(x, y).as_dvec3();
         let o = c.position.as_dvec3();

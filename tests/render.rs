@@ -142,7 +142,7 @@ fn floor_under(light: impl FnOnce(&mut common::Builder)) -> Scene {
 
 /// Where pixel (x, y)'s centre ray meets the floor y = 0.
 fn floor_hit(scene: &Scene, x: usize, y: usize) -> Vec3 {
-    let c = &scene.camera;
+    let c = &scene.camera();
     let d = c.direction(x as f32 + 0.5, y as f32 + 0.5);
     c.position + d * (-c.position.y / d.y)
 }
@@ -167,7 +167,11 @@ fn assert_direct_light_is_exact(scene: &Scene, exact: impl Fn(Vec3) -> f64) {
                 direct,
                 ..meshlight::RenderOptions::default()
             };
-            let (image, _) = meshlight::render(scene, &solution, vis.as_ref(), &options).unwrap();
+            let (image, _) =
+                meshlight::render(scene, &solution, vis.as_ref(), &options, &mut |_| {
+                    meshlight::Control::Continue
+                })
+                .unwrap();
             let w = image.width as usize;
             for (i, p) in image.pixels.iter().enumerate() {
                 let e = exact(floor_hit(scene, i % w, i / w));

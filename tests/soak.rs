@@ -114,8 +114,12 @@ fn two_hundred_solves_leave_nothing_behind() {
         .map(|name| Scene::load(shipped(name)).unwrap())
         .collect();
     for s in &mut scenes {
-        s.camera.width = 32;
-        s.camera.height = 24;
+        let camera = meshlight::scene::Camera {
+            width: 32,
+            height: 24,
+            ..s.camera().clone()
+        };
+        s.set_camera(camera).unwrap();
     }
     let backends = Backend::available();
     let mut state = 0x2545_F491_4F6C_DD1Du64;
@@ -152,7 +156,7 @@ fn two_hundred_solves_leave_nothing_behind() {
         };
         let options = Options {
             epsilon: Some(
-                0.4 * (1.0 + if first { 0 } else { next(3) } as f32) * scene.bounds.diagonal()
+                0.4 * (1.0 + if first { 0 } else { next(3) } as f32) * scene.bounds().diagonal()
                     / 10.0,
             ),
             rounds: if first { 2 } else { next(3) as u32 },
@@ -185,7 +189,9 @@ fn two_hundred_solves_leave_nothing_behind() {
                     threads: options.threads,
                     ..RenderOptions::default()
                 };
-                match meshlight::render(scene, &solution, vis.as_ref(), &render) {
+                match meshlight::render(scene, &solution, vis.as_ref(), &render, &mut |_| {
+                    meshlight::Control::Continue
+                }) {
                     Ok((image, _)) => assert!(image.mean().is_finite()),
                     Err(e) => {
                         assert!(breaking, "solve {i}: {e}");

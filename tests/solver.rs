@@ -8,7 +8,6 @@ use common::{
     assert_dark_room_is_dark, backends, camera, material, shipped, solve, two_rooms, Builder,
 };
 use glam::{DVec3, Vec3};
-use meshlight::sampling::{is_back, surface_of};
 use meshlight::scene::PointLight;
 use meshlight::solver::{transfer, Control, Options, StopReason};
 use meshlight::{Backend, Scene};
@@ -28,14 +27,14 @@ fn furnace_every_sample_is_at_the_analytic_radiance() {
         );
         assert_eq!(s.stop(), StopReason::Converged);
         let mut worst = 0.0f64;
-        for b in &s.radiosity {
+        for b in s.radiosity() {
             let l = b / std::f64::consts::PI;
             worst = worst.max((l - DVec3::splat(0.2)).abs().max_element() / 0.2);
         }
         assert!(
             worst < 0.01,
             "{backend}: worst relative error {worst:.4} over {} samples",
-            s.samples.len()
+            s.samples().len()
         );
     }
 }
@@ -57,14 +56,14 @@ fn meshless_flux(scene: &Scene, source: u32, receiver: u32) -> Vec<f64> {
                 &mut |_| Control::Continue,
             )
             .unwrap();
-            let samples = &s.samples;
+            let samples = &s.samples();
             let shooters: Vec<u32> = (0..samples.len() as u32)
-                .filter(|&k| surface_of(samples.side[k as usize]) == source)
+                .filter(|&k| samples.surface(k as usize) == source)
                 .collect();
             let h = transfer(scene, &s, vis.as_ref(), &shooters, DVec3::ONE).unwrap();
             (0..samples.len())
-                .filter(|&k| surface_of(samples.side[k]) == receiver && !is_back(samples.side[k]))
-                .map(|k| h[k].x * samples.area[k])
+                .filter(|&k| samples.surface(k as usize) == receiver && !samples.is_back(k))
+                .map(|k| h[k].x * samples.area()[k])
                 .sum()
         })
         .collect()
@@ -101,7 +100,7 @@ fn two_squares(a: [Vec3; 4], b: [Vec3; 4]) -> Scene {
 fn form_factor_of_parallel_coaxial_unit_squares() {
     // Unit squares at distance 1, facing each other: F = 0.1998.
     let scene = two_squares(UPPER_SQUARE, LOWER_SQUARE);
-    assert!((scene.surfaces[0].normal - Vec3::NEG_Z).length() < 1e-6);
+    assert!((scene.surfaces()[0].normal - Vec3::NEG_Z).length() < 1e-6);
     for flux in meshless_flux(&scene, 0, 1) {
         assert!(
             (flux - 0.1998).abs() < 0.02 * 0.1998,
@@ -153,8 +152,8 @@ fn direct_light_from_an_area_light_delivers_its_form_factor() {
                 ..Options::default()
             },
         );
-        let flux: f64 = (0..s.samples.len())
-            .map(|k| s.direct[k].irradiance.x * s.samples.area[k])
+        let flux: f64 = (0..s.samples().len())
+            .map(|k| s.direct()[k].irradiance.x * s.samples().area()[k])
             .sum();
         let expected = std::f64::consts::PI * 0.1998;
         eprintln!(
@@ -180,20 +179,23 @@ fn areas_are_conserved_per_surface_also_after_adaptive_rounds() {
         },
     );
     assert!(
-        s.rounds.len() >= 2 && s.rounds[1].added > 0,
+        s.rounds().len() >= 2 && s.rounds()[1].added > 0,
         "adaptive rounds added samples"
     );
-    let per_side = s.samples.area_per_side(2 * scene.surfaces.len()).unwrap();
+    let per_side = s
+        .samples()
+        .area_per_side(2 * scene.surfaces().len())
+        .unwrap();
     for (side, &area) in per_side.iter().enumerate() {
         if area > 0.0 {
-            let expected = scene.surfaces[side / 2].area;
+            let expected = scene.surfaces()[side / 2].area;
             assert!(
                 (area - expected).abs() <= 1e-3 * expected,
                 "side {side}: {area} vs {expected}"
             );
         }
     }
-    assert!(s.samples.area.iter().all(|&a| a >= 0.0));
+    assert!(s.samples().area().iter().all(|&a| a >= 0.0));
 }
 
 /// An open scene: a 4 m × 4 m floor and a 4 m × 2 m wall along one edge, a point light.
@@ -235,8 +237,8 @@ fn open_scene() -> Scene {
 fn reflected_escape(s: &meshlight::Solution, vis: &dyn meshlight::Visibility, rays: usize) -> f64 {
     let n = (rays as f64).sqrt() as usize;
     let mut out = 0.0;
-    for k in 0..s.samples.len() {
-        let normal = s.samples.normal[k];
+    for k in 0..s.samples().len() {
+        let normal = s.samples().normal()[k];
         let a = if normal.x.abs() < 0.9 {
             Vec3::X
         } else {
@@ -244,7 +246,7 @@ fn reflected_escape(s: &meshlight::Solution, vis: &dyn meshlight::Visibility, ra
         };
         let t = (a - normal * normal.dot(a)).normalize();
         let b = normal.cross(t);
-        let origin = s.samples.position[k] + normal * 1e-4;
+        let origin = s.samples().position()[k] + normal * 1e-4;
         let batch: Vec<meshlight::visibility::Ray> = (0..n * n)
             .map(|i| {
                 // Malley: a uniform point of the disc lifted onto the hemisphere.
@@ -265,8 +267,8 @@ fn reflected_escape(s: &meshlight::Solution, vis: &dyn meshlight::Visibility, ra
         let mut hits = vec![None; batch.len()];
         vis.intersect(&batch, &mut hits).unwrap();
         let missed = hits.iter().filter(|h| h.is_none()).count() as f64 / batch.len() as f64;
-        let shot = s.radiosity[k].x - s.unshot[k].x;
-        out += shot * s.samples.area[k] * missed;
+        let shot = s.radiosity()[k].x - s.unshot()[k].x;
+        out += shot * s.samples().area()[k] * missed;
     }
     out
 }
@@ -291,9 +293,9 @@ fn energy_balance_in_an_open_scene() {
                 ..Options::default()
             },
         );
-        let emitted = s.ledger.emitted.x;
+        let emitted = s.ledger().emitted.x;
         let absorbed = s.absorbed(&scene).x;
-        let escaped = s.ledger.escaped.x;
+        let escaped = s.ledger().escaped.x;
         let unshot = s.unshot_power().x;
         let balance = (absorbed + escaped + unshot - emitted).abs() / emitted;
         assert!(balance < 1e-3, "{backend}: emitted {emitted} vs absorbed {absorbed} + escaped {escaped} + unshot {unshot}");
@@ -317,9 +319,9 @@ fn energy_balance_in_an_open_scene() {
         );
 
         // Independently: the direct flux on the floor is I × its solid angle from the light.
-        let floor_flux: f64 = (0..s.samples.len())
-            .filter(|&k| surface_of(s.samples.side[k]) == 0)
-            .map(|k| s.direct[k].irradiance.x * s.samples.area[k])
+        let floor_flux: f64 = (0..s.samples().len())
+            .filter(|&k| s.samples().surface(k) == 0)
+            .map(|k| s.direct()[k].irradiance.x * s.samples().area()[k])
             .sum();
         let exact = 10.0 * rectangle_solid_angle(-1.5, 2.5, -1.0, 3.0, 1.5);
         assert!(
@@ -357,16 +359,16 @@ fn point_light_over_a_large_plane_follows_the_inverse_square_law() {
                 ..Options::default()
             },
         );
-        assert!(s.samples.len() > 1000);
+        assert!(s.samples().len() > 1000);
         // By hand: a light at height h = 2 over the plane y = 0 gives E = I·cosθ/r² with
         // cosθ = h/r, so E = I·h/r³ with r² = (x − 1)² + h² + (z + 0.5)².
         let intensity = DVec3::new(5.0, 10.0, 20.0);
         let mut worst = 0.0f64;
-        for k in 0..s.samples.len() {
-            let p = s.samples.position[k];
+        for k in 0..s.samples().len() {
+            let p = s.samples().position()[k];
             let r = f64::from(((p.x - 1.0).powi(2) + 4.0 + (p.z + 0.5).powi(2)).sqrt());
             let expected = intensity * 2.0 / (r * r * r);
-            let got = s.direct[k].irradiance;
+            let got = s.direct()[k].irradiance;
             worst = worst.max((got - expected).abs().max_element() / expected.max_element());
             assert!(
                 (got - expected).abs().max_element() <= 1e-4 * expected.max_element(),
@@ -375,7 +377,7 @@ fn point_light_over_a_large_plane_follows_the_inverse_square_law() {
         }
         eprintln!(
             "worst relative error {worst:.2e} over {} samples",
-            s.samples.len()
+            s.samples().len()
         );
     }
 }
@@ -417,9 +419,9 @@ fn one_or_two_threads_give_bit_identical_radiosity() {
             ..Options::default()
         },
     );
-    assert_eq!(one.samples, two.samples);
+    assert_eq!(one.samples(), two.samples());
     assert!(
-        one.radiosity == two.radiosity,
+        one.radiosity() == two.radiosity(),
         "radiosity differs between 1 and 2 threads"
     );
 }
@@ -435,10 +437,10 @@ fn embree_and_obvhs_give_the_same_radiosity() {
     };
     let a = solve(&scene, Backend::Embree, options.clone());
     let b = solve(&scene, Backend::Bvh, options);
-    assert_eq!(a.samples, b.samples);
-    let mean =
-        a.radiosity.iter().map(|b| b.element_sum()).sum::<f64>() / (3 * a.radiosity.len()) as f64;
-    for (k, (x, y)) in a.radiosity.iter().zip(&b.radiosity).enumerate() {
+    assert_eq!(a.samples(), b.samples());
+    let mean = a.radiosity().iter().map(|b| b.element_sum()).sum::<f64>()
+        / (3 * a.radiosity().len()) as f64;
+    for (k, (x, y)) in a.radiosity().iter().zip(b.radiosity()).enumerate() {
         let scale = x.abs().max(*y).max_element().max(mean);
         assert!(
             (*x - *y).abs().max_element() <= 1e-4 * scale,
@@ -451,14 +453,14 @@ fn embree_and_obvhs_give_the_same_radiosity() {
 fn adaptive_rounds_put_samples_at_shadow_boundaries() {
     let scene = Scene::load(shipped("room")).unwrap();
     let s = solve(&scene, Backend::default_backend(), Options::default());
-    let initial: Vec<usize> = (0..s.samples.len())
-        .filter(|&k| s.samples.round[k] == 0)
+    let initial: Vec<usize> = (0..s.samples().len())
+        .filter(|&k| s.samples().round()[k] == 0)
         .collect();
     // Penumbra: initial samples that see part of the light; the rest are fully lit or dark.
     let penumbra: Vec<usize> = initial
         .iter()
         .copied()
-        .filter(|&k| s.direct[k].visible > 0.02 && s.direct[k].visible < 0.98)
+        .filter(|&k| s.direct()[k].visible > 0.02 && s.direct()[k].visible < 0.98)
         .collect();
     let other: Vec<usize> = initial
         .iter()
@@ -466,15 +468,17 @@ fn adaptive_rounds_put_samples_at_shadow_boundaries() {
         .filter(|&k| !penumbra.contains(&k))
         .collect();
     // Samples now within ε of those initial samples, per initial sample.
-    let eps2 = s.epsilon * s.epsilon;
+    let eps2 = s.epsilon() * s.epsilon();
     let density = |group: &[usize]| -> f64 {
         let count: usize = group
             .iter()
             .map(|&g| {
-                (0..s.samples.len())
+                (0..s.samples().len())
                     .filter(|&k| {
-                        s.samples.side[k] == s.samples.side[g]
-                            && s.samples.position[k].distance_squared(s.samples.position[g]) < eps2
+                        (s.samples().surface(k), s.samples().is_back(k))
+                            == (s.samples().surface(g), s.samples().is_back(g))
+                            && s.samples().position()[k].distance_squared(s.samples().position()[g])
+                                < eps2
                     })
                     .count()
             })
@@ -497,7 +501,7 @@ fn a_dark_scene_is_all_zero_and_says_so() {
     let scene = builder.scene(camera(Vec3::splat(0.5), Vec3::new(0.5, 0.5, 1.0), 8));
     let s = solve(&scene, Backend::default_backend(), Options::default());
     assert_eq!(s.stop(), StopReason::NoLight);
-    assert!(s.radiosity.iter().all(|b| *b == DVec3::ZERO));
+    assert!(s.radiosity().iter().all(|b| *b == DVec3::ZERO));
 }
 
 #[test]
@@ -521,9 +525,9 @@ fn a_stopped_solve_returns_its_current_estimate() {
         })
         .unwrap();
         assert_eq!(s.stop(), StopReason::Stopped);
-        assert_eq!(s.rounds.len(), 1);
-        assert_eq!(s.rounds[0].shooting.shots, limit, "threshold {threshold}");
-        assert!(s.radiosity.iter().any(|b| b.x > 0.0));
+        assert_eq!(s.rounds().len(), 1);
+        assert_eq!(s.rounds()[0].shooting.shots, limit, "threshold {threshold}");
+        assert!(s.radiosity().iter().any(|b| b.x > 0.0));
         assert!(reports > 3);
     }
 }
@@ -549,8 +553,8 @@ fn too_small_an_epsilon_is_refused_before_allocating() {
 /// distance to the panel's outline lies in `lo..hi` (metres).
 fn ceiling_ring(s: &meshlight::Solution, lo: f32, hi: f32) -> f64 {
     let (mut sum, mut count) = (0.0, 0);
-    for k in 0..s.samples.len() {
-        let (p, n) = (s.samples.position[k], s.samples.normal[k]);
+    for k in 0..s.samples().len() {
+        let (p, n) = (s.samples().position()[k], s.samples().normal()[k]);
         if (p.y - 5.5).abs() > 1e-3 || n.y > -0.5 {
             continue;
         }
@@ -559,7 +563,7 @@ fn ceiling_ring(s: &meshlight::Solution, lo: f32, hi: f32) -> f64 {
         let dz = ((p.z - 6.25).abs() - 0.6).max(0.0);
         let d = dx.hypot(dz);
         if d >= lo && d < hi {
-            sum += s.radiosity[k].y;
+            sum += s.radiosity()[k].y;
             count += 1;
         }
     }

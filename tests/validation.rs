@@ -79,8 +79,8 @@ fn assert_names(message: &str, location: &str, problem: &str) {
 fn the_valid_scene_loads() {
     let dir = tempfile::tempdir().unwrap();
     let scene = Scene::load(write(dir.path(), &Files::default())).unwrap();
-    assert_eq!((scene.triangles.len(), scene.surfaces.len()), (2, 1));
-    assert!(scene.warnings.is_empty());
+    assert_eq!((scene.triangles().len(), scene.surfaces().len()), (2, 1));
+    assert!(scene.warnings().is_empty());
 }
 
 #[test]
@@ -384,13 +384,13 @@ fn zero_area_triangles_are_dropped_with_one_warning() {
         },
     ))
     .unwrap();
-    assert_eq!(scene.triangles.len(), 2);
+    assert_eq!(scene.triangles().len(), 2);
     let warnings: Vec<&String> = scene
-        .warnings
+        .warnings()
         .iter()
         .filter(|w| w.contains("zero-area"))
         .collect();
-    assert_eq!(warnings.len(), 1, "{:?}", scene.warnings);
+    assert_eq!(warnings.len(), 1, "{:?}", scene.warnings());
     assert!(
         warnings[0].contains("s.obj: dropped 3 zero-area triangles"),
         "{}",
@@ -410,13 +410,16 @@ fn faces_without_material_get_grey_and_one_warning() {
         },
     ))
     .unwrap();
-    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert_eq!(scene.warnings().len(), 1, "{:?}", scene.warnings());
     assert!(
-        scene.warnings[0].contains("2 triangles have no material"),
+        scene.warnings()[0].contains("2 triangles have no material"),
         "{}",
-        scene.warnings[0]
+        scene.warnings()[0]
     );
-    assert_eq!(scene.material_of(0).kd, glam::Vec3::splat(0.5));
+    assert_eq!(
+        scene.materials()[scene.surfaces()[0].material as usize].kd,
+        glam::Vec3::splat(0.5)
+    );
 }
 
 #[test]
@@ -589,11 +592,11 @@ fn truncated_files_are_errors_not_panics() {
     .unwrap();
     assert!(
         scene
-            .warnings
+            .warnings()
             .iter()
             .any(|w| w.contains("ignored 1 face with fewer than 3 vertices")),
         "{:?}",
-        scene.warnings
+        scene.warnings()
     );
 }
 
@@ -625,7 +628,7 @@ fn scenes_load_from_memory_too() {
         .with("s.obj", OBJ)
         .with("s.mtl", MTL);
     let scene = Scene::load_from(&files, "scene.toml").unwrap();
-    assert_eq!(scene.triangles.len(), 2);
+    assert_eq!(scene.triangles().len(), 2);
     let e = Scene::load_from(&Memory::default().with("scene.toml", TOML), "scene.toml")
         .unwrap_err()
         .to_string();

@@ -27,9 +27,9 @@ fuzz_target!(|data: &[u8]| {
     let files = Parts([parts.next().unwrap_or(&[]), parts.next().unwrap_or(&[]), parts.next().unwrap_or(&[])]);
     if let Ok(scene) = Scene::load_from(&files, "scene.toml") {
         // What loaded must be usable: finite geometry, at least one triangle, valid camera.
-        assert!(!scene.triangles.is_empty());
-        assert!(scene.triangles.iter().all(|t| t.area > 0.0 && t.normal.is_finite()));
-        assert!(scene.camera.problem().is_none());
-        assert!(scene.bounds.diagonal().is_finite());
+        assert!(!scene.triangles().is_empty());
+        assert!(scene.triangles().iter().all(|t| t.area > 0.0 && t.normal.is_finite()));
+        assert!(scene.camera().problem().is_none());
+        assert!(scene.bounds().diagonal().is_finite());
     }
 });

@@ -4,6 +4,6 @@
 mod patches;
 mod path;
 
-pub use patches::{patch_radiosity, PatchImage, PatchOptions, PatchProgress};
+pub use patches::{patch_radiosity, PatchImage, PatchOptions};
 
-pub use path::{path_trace, PathImage, PathOptions, PathProgress};
+pub use path::{path_trace, PathImage, PathOptions};

@@ -17,6 +17,7 @@ use rand_pcg::Pcg64Mcg;
 
 use crate::error::{Error, Result};
 use crate::parallel::for_chunks;
+use crate::progress::{Callback, Phase, Progress, Reporter};
 use crate::render::Image;
 use crate::scene::Scene;
 use crate::visibility::{Hit, Ray, Segment, Visibility};
@@ -64,15 +65,9 @@ pub struct PathImage {
     pub noise: f64,
     /// Paths traced and rays cast (camera, bounces and shadow rays).
     pub rays: u64,
-}
-
-/// How far a path-traced render has got: samples per pixel done, and wanted.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PathProgress {
-    /// Samples per pixel done.
-    pub done: u32,
-    /// Samples per pixel wanted.
-    pub wanted: u32,
+    /// Whether the host stopped the render (after a whole pass: `spp` says how many samples
+    /// each pixel got).
+    pub stopped: bool,
 }
 
 /// An emitting triangle, with its choice probability by power.
@@ -160,12 +155,15 @@ struct Shadow {
     contribution: DVec3,
 }
 
-/// Renders the scene's camera view by path tracing. `progress` hears every pass.
+/// Renders the scene's camera view by path tracing. `progress` hears every pass
+/// ([`Phase::Tracing`]: `items` the samples per pixel wanted, `shots` those done) and may stop
+/// the render after a pass that leaves an even number of samples per pixel (each half-image
+/// gets its share; the first pass always runs).
 pub fn path_trace(
     scene: &Scene,
     vis: &dyn Visibility,
     options: &PathOptions,
-    progress: &mut dyn FnMut(&PathProgress),
+    progress: Callback,
 ) -> Result<PathImage> {
     crate::parallel::guarded("the path tracer", || {
         if options.spp < 2 {
@@ -191,7 +189,15 @@ pub fn path_trace(
         let pass = 2u32.max(options.spp / 32).min(options.spp);
         let mut done = 0u32;
         let points = scene.point_sources();
-        while done < options.spp {
+        let mut reporter = Reporter::new(progress);
+        let base = Progress {
+            items: options.spp as usize,
+            ..Progress::of(Phase::Tracing)
+        };
+        // The first pass runs whatever the host says: both half-images need samples.
+        reporter.report(base);
+        let mut stopped = false;
+        while done < options.spp && !stopped {
             let count = pass.min(options.spp - done);
             let first = done;
             let tracer = Tracer {
@@ -209,16 +215,21 @@ pub fn path_trace(
                 Ok(())
             })?;
             done += count;
-            progress(&PathProgress {
-                done,
-                wanted: options.spp,
+            let stop = reporter.report(Progress {
+                fraction: f64::from(done) / f64::from(options.spp),
+                shots: u64::from(done),
+                ..base
             });
-            if options
-                .seconds
-                .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
-                && done % 2 == 0
-            {
-                break;
+            // Whole pairs of samples only: the half-images need one each.
+            if done % 2 == 0 && done < options.spp {
+                if stop {
+                    stopped = true;
+                } else if options
+                    .seconds
+                    .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
+                {
+                    break;
+                }
             }
         }
         let image_of = |f: &dyn Fn(&[DVec3; 2]) -> DVec3| Image {
@@ -244,6 +255,7 @@ pub fn path_trace(
             spp: done,
             noise: if mean > 0.0 { diff / 2.0 / mean } else { 0.0 },
             rays: *rays.get_mut(),
+            stopped,
         })
     })
 }

@@ -14,7 +14,8 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::light::DirectLight;
-use crate::parallel::for_chunks;
+use crate::parallel::for_chunks_reporting;
+use crate::progress::{Callback, Control, Phase, Progress, Reporter};
 use crate::sampling::{cover, is_back, side_of, surface_of, Side};
 use crate::scene::Scene;
 use crate::solver::Solution;
@@ -89,6 +90,7 @@ impl Default for RenderOptions {
 
 /// What rendering did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct RenderStats {
     /// Camera rays traced.
     pub camera_rays: u64,
@@ -98,14 +100,22 @@ pub struct RenderStats {
     pub shadow_rays: u64,
     /// Pixels that got the grid of rays.
     pub supersampled_pixels: u64,
+    /// Whether the host stopped the render: pixels not reached are black, and edges not
+    /// refined keep their centre ray's value.
+    pub stopped: bool,
 }
 
-/// Renders the scene's camera view of a solution.
+/// Share of the progress reports the centre rays take (the edges take the rest).
+const CENTRE_SHARE: f64 = 0.7;
+
+/// Renders the scene's camera view of a solution. `progress` hears the share of pixels done
+/// ([`Phase::Rendering`]) and may stop the render (see [`RenderStats::stopped`]).
 pub fn render(
     scene: &Scene,
     solution: &Solution,
     vis: &dyn Visibility,
     options: &RenderOptions,
+    progress: Callback,
 ) -> Result<(Image, RenderStats)> {
     crate::parallel::guarded("rendering", || {
         let camera = &scene.camera;
@@ -125,11 +135,17 @@ pub fn render(
         let (w, h) = (camera.width as usize, camera.height as usize);
         let shader = Shader::new(scene, solution, vis, options);
         let mut stats = RenderStats::default();
+        let mut reporter = Reporter::new(progress);
+        let base = Progress {
+            items: w * h,
+            ..Progress::of(Phase::Rendering)
+        };
+        reporter.report(base);
 
         // Centre rays: radiance and the side each pixel sees.
         let mut centre: Vec<(Vec3, u32)> = vec![(Vec3::ZERO, u32::MAX); w * h];
         let queries = std::sync::atomic::AtomicU64::new(0);
-        for_chunks(&mut centre, w * 4, options.threads, |first, out| {
+        let trace = |first: usize, out: &mut [(Vec3, u32)]| {
             let rays: Vec<Ray> = (first..first + out.len())
                 .map(|p| camera_ray(scene, (p % w) as f32 + 0.5, (p / w) as f32 + 0.5))
                 .collect();
@@ -138,98 +154,48 @@ pub fn render(
                 std::sync::atomic::Ordering::Relaxed,
             );
             Ok(())
-        })?;
+        };
+        let all = !reporter.stopped()
+            && for_chunks_reporting(&mut centre, w * 4, options.threads, trace, &mut |f| {
+                control(reporter.report(Progress {
+                    fraction: CENTRE_SHARE * f,
+                    ..base
+                }))
+            })?;
         stats.camera_rays = (w * h) as u64;
 
-        // Edge pixels: a neighbour, diagonal ones included (a corner may cut a pixel whose four
-        // nearest neighbours all see what it sees), sees another side.
-        let n = options.supersample.max(1) as usize;
-        let edges: Vec<usize> = if n > 1 {
-            (0..w * h)
-                .filter(|&p| neighbours(p, w, h).any(|q| centre[q].1 != centre[p].1))
-                .collect()
+        // Edge pixels, refined with more rays.
+        let edges = if all && options.supersample > 1 {
+            edge_pixels(&centre, w, h, options.supersample as usize)
         } else {
-            Vec::new()
+            Edges::default()
         };
-        // Rays per side for each edge pixel: `n`, more where the edge's contrast is high (the
-        // rim of a light): a jittered grid's coverage error scales with the contrast.
-        let mean = centre
-            .iter()
-            .map(|c| f64::from(c.0.element_sum()))
-            .sum::<f64>()
-            / (3 * w * h) as f64;
-        let per_side: Vec<usize> = edges
-            .iter()
-            .map(|&p| {
-                let values = || neighbours(p, w, h).map(|q| centre[q].0.max_element());
-                let here = centre[p].0.max_element();
-                let contrast = values().fold(here, f32::max) - values().fold(here, f32::min);
-                let ratio = f64::from(contrast) / mean;
-                let m = if ratio.is_finite() && ratio > 1.0 {
-                    (ratio.sqrt().ceil() as usize).min(MAX_EDGE_BOOST)
-                } else {
-                    1
-                };
-                n * m
-            })
-            .collect();
-        // First ray id of each edge pixel: ids past the centre rays', one per ray.
-        let mut first_ray = Vec::with_capacity(edges.len() + 1);
-        let mut total = w * h;
-        for &k in &per_side {
-            first_ray.push(total);
-            total += k * k;
-        }
-        first_ray.push(total);
-        let mut refined = vec![Vec3::ZERO; edges.len()];
-        for_chunks(&mut refined, 64, options.threads, |first, out| {
-            let mut rays = Vec::with_capacity(first_ray[first + out.len()] - first_ray[first]);
-            for (&p, &n) in edges[first..first + out.len()]
-                .iter()
-                .zip(&per_side[first..])
-            {
-                let (x, y) = ((p % w) as f32, (p / w) as f32);
-                // Stratified and jittered: a regular grid measures a straight edge's coverage in
-                // steps of 1/n with the same error all along the edge, which biased the mean of a
-                // small image by the bright edge pixels of a light.
-                let mut h = p as u64 ^ 0x5851_f42d_4c95_7f2d;
-                let mut jitter = || {
-                    h = h
-                        .wrapping_mul(6_364_136_223_846_793_005)
-                        .wrapping_add(1_442_695_040_888_963_407);
-                    ((h >> 40) as f32) / (1u64 << 24) as f32
-                };
-                for j in 0..n {
-                    for i in 0..n {
-                        let (dx, dy) = (
-                            (i as f32 + jitter()) / n as f32,
-                            (j as f32 + jitter()) / n as f32,
-                        );
-                        rays.push(camera_ray(scene, x + dx, y + dy));
-                    }
-                }
-            }
-            let mut shaded = vec![(Vec3::ZERO, 0u32); rays.len()];
+        let mut refined = vec![None; edges.pixels.len()];
+        let refine = |first: usize, out: &mut [Option<Vec3>]| {
             queries.fetch_add(
-                shader.shade(&rays, first_ray[first] as u32, &mut shaded)?,
+                edges.shade(scene, &shader, first, out, w)?,
                 std::sync::atomic::Ordering::Relaxed,
             );
-            let mut rest = &shaded[..];
-            for (o, &n) in out.iter_mut().zip(&per_side[first..]) {
-                let (group, tail) = rest.split_at(n * n);
-                *o = group.iter().map(|s| s.0).sum::<Vec3>() / (n * n) as f32;
-                rest = tail;
-            }
             Ok(())
-        })?;
-        stats.camera_rays += (total - w * h) as u64;
-        stats.supersampled_pixels = edges.len() as u64;
+        };
+        let all = all
+            && for_chunks_reporting(&mut refined, 64, options.threads, refine, &mut |f| {
+                control(reporter.report(Progress {
+                    fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,
+                    ..base
+                }))
+            })?;
+        stats.camera_rays += (edges.first_ray.last().copied().unwrap_or(w * h) - w * h) as u64;
+        stats.supersampled_pixels = refined.iter().filter(|r| r.is_some()).count() as u64;
         stats.interpolation_queries = queries.into_inner();
         stats.shadow_rays = shader.shadow_rays.into_inner();
+        stats.stopped = !all;
 
         let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
-        for (&p, &value) in edges.iter().zip(&refined) {
-            pixels[p] = value;
+        for (&p, value) in edges.pixels.iter().zip(&refined) {
+            if let Some(value) = value {
+                pixels[p] = *value;
+            }
         }
         Ok((
             Image {
@@ -240,6 +206,118 @@ pub fn render(
             stats,
         ))
     })
+}
+
+fn control(stop: bool) -> Control {
+    if stop {
+        Control::Stop
+    } else {
+        Control::Continue
+    }
+}
+
+/// The pixels on edges between surface sides, and how many rays each gets.
+#[derive(Default)]
+struct Edges {
+    /// Pixel indices.
+    pixels: Vec<usize>,
+    /// Rays per side of each pixel's jittered grid.
+    per_side: Vec<usize>,
+    /// First ray id of each edge pixel (ids past the centre rays', one per ray), and one past
+    /// the last.
+    first_ray: Vec<usize>,
+}
+
+/// Edge pixels: a neighbour, diagonal ones included (a corner may cut a pixel whose four
+/// nearest neighbours all see what it sees), sees another side. Each gets `n` rays per side,
+/// more where the edge's contrast is high (the rim of a light): a jittered grid's coverage
+/// error scales with the contrast.
+fn edge_pixels(centre: &[(Vec3, u32)], w: usize, h: usize, n: usize) -> Edges {
+    let pixels: Vec<usize> = (0..w * h)
+        .filter(|&p| neighbours(p, w, h).any(|q| centre[q].1 != centre[p].1))
+        .collect();
+    let mean = centre
+        .iter()
+        .map(|c| f64::from(c.0.element_sum()))
+        .sum::<f64>()
+        / (3 * w * h) as f64;
+    let per_side: Vec<usize> = pixels
+        .iter()
+        .map(|&p| {
+            let values = || neighbours(p, w, h).map(|q| centre[q].0.max_element());
+            let here = centre[p].0.max_element();
+            let contrast = values().fold(here, f32::max) - values().fold(here, f32::min);
+            let ratio = f64::from(contrast) / mean;
+            let m = if ratio.is_finite() && ratio > 1.0 {
+                (ratio.sqrt().ceil() as usize).min(MAX_EDGE_BOOST)
+            } else {
+                1
+            };
+            n * m
+        })
+        .collect();
+    let mut first_ray = Vec::with_capacity(pixels.len() + 1);
+    let mut total = w * h;
+    for &k in &per_side {
+        first_ray.push(total);
+        total += k * k;
+    }
+    first_ray.push(total);
+    Edges {
+        pixels,
+        per_side,
+        first_ray,
+    }
+}
+
+impl Edges {
+    /// Shades edge pixels `first..first + out.len()` with their grids of rays; the
+    /// interpolation queries made.
+    fn shade(
+        &self,
+        scene: &Scene,
+        shader: &Shader,
+        first: usize,
+        out: &mut [Option<Vec3>],
+        w: usize,
+    ) -> Result<u64> {
+        let mut rays =
+            Vec::with_capacity(self.first_ray[first + out.len()] - self.first_ray[first]);
+        for (&p, &n) in self.pixels[first..first + out.len()]
+            .iter()
+            .zip(&self.per_side[first..])
+        {
+            let (x, y) = ((p % w) as f32, (p / w) as f32);
+            // Stratified and jittered: a regular grid measures a straight edge's coverage in
+            // steps of 1/n with the same error all along the edge, which biased the mean of a
+            // small image by the bright edge pixels of a light.
+            let mut h = p as u64 ^ 0x5851_f42d_4c95_7f2d;
+            let mut jitter = || {
+                h = h
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                ((h >> 40) as f32) / (1u64 << 24) as f32
+            };
+            for j in 0..n {
+                for i in 0..n {
+                    let (dx, dy) = (
+                        (i as f32 + jitter()) / n as f32,
+                        (j as f32 + jitter()) / n as f32,
+                    );
+                    rays.push(camera_ray(scene, x + dx, y + dy));
+                }
+            }
+        }
+        let mut shaded = vec![(Vec3::ZERO, 0u32); rays.len()];
+        let queries = shader.shade(&rays, self.first_ray[first] as u32, &mut shaded)?;
+        let mut rest = &shaded[..];
+        for (o, &n) in out.iter_mut().zip(&self.per_side[first..]) {
+            let (group, tail) = rest.split_at(n * n);
+            *o = Some(group.iter().map(|s| s.0).sum::<Vec3>() / (n * n) as f32);
+            rest = tail;
+        }
+        Ok(queries)
+    }
 }
 
 /// The up to eight pixels around pixel p of a w × h image.

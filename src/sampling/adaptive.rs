@@ -18,7 +18,7 @@ use rand_pcg::Pcg64Mcg;
 use super::poisson::side_seed;
 use super::{surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::error::Result;
-use crate::parallel::{for_chunks, for_chunks_reporting};
+use crate::parallel::{for_chunks, for_chunks_reporting, Report};
 use crate::visibility::Visibility;
 
 /// Radii stop shrinking at ε / MAX_SPLIT.
@@ -62,7 +62,8 @@ pub struct RefineSettings {
 }
 
 /// Eq. 7's error of every sample, relative to the mean luminance of `radiosity`; NaN where a
-/// sample has no neighbour within 2D that it sees along its side. On up to `threads` threads.
+/// sample has no neighbour within 2D that it sees along its side. On up to `threads` threads;
+/// `None` if `report` answered Stop.
 #[allow(clippy::too_many_arguments)]
 pub fn errors(
     samples: &Samples,
@@ -72,8 +73,8 @@ pub fn errors(
     vis: &dyn Visibility,
     radiosity: &[DVec3],
     threads: usize,
-    report: &mut dyn FnMut(f64),
-) -> Result<Vec<f64>> {
+    report: Report,
+) -> Result<Option<Vec<f64>>> {
     let n = samples.len();
     let mean = radiosity.iter().map(|&b| luminance(b)).sum::<f64>() / n.max(1) as f64;
     let mut out = vec![0.0; n];
@@ -99,8 +100,8 @@ pub fn errors(
         }
         Ok(())
     };
-    for_chunks_reporting(&mut out, 1024, threads, error, report)?;
-    Ok(out)
+    let all = for_chunks_reporting(&mut out, 1024, threads, error, report)?;
+    Ok(all.then_some(out))
 }
 
 /// Refines where the error exceeds ζ: shrinks those samples' radii and adds new samples
@@ -115,9 +116,9 @@ pub fn refine(
     vis: &dyn Visibility,
     radiosity: &[DVec3],
     settings: RefineSettings,
-    report: &mut dyn FnMut(f64),
+    report: Report,
 ) -> Result<Refinement> {
-    let errors = errors(
+    let Some(errors) = errors(
         samples,
         maps,
         index,
@@ -126,7 +127,11 @@ pub fn refine(
         radiosity,
         settings.threads,
         report,
-    )?;
+    )?
+    else {
+        // Told to stop: nothing added.
+        return Ok(Refinement::default());
+    };
     let mut result = Refinement::default();
     let eps = settings.epsilon;
     let min_radius = eps / MAX_SPLIT;

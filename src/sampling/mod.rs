@@ -48,35 +48,36 @@ pub fn reflecting_sides(scene: &Scene) -> Vec<Side> {
     sides
 }
 
-/// The sample points, structure of arrays.
+/// The sample points, structure of arrays. Read through its accessors; only the solver
+/// changes them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Samples {
     /// Positions, on their surfaces.
-    pub position: Vec<Vec3>,
+    pub(crate) position: Vec<Vec3>,
     /// Unit normal of the side each sample is on.
-    pub normal: Vec<Vec3>,
+    pub(crate) normal: Vec<Vec3>,
     /// 2D position in its surface's frame.
-    pub uv: Vec<Vec2>,
+    pub(crate) uv: Vec<Vec2>,
     /// The side each sample is on.
-    pub side: Vec<Side>,
+    pub(crate) side: Vec<Side>,
     /// Influence radius D (eq. 3: ε initially; shrunk by adaptive rounds).
-    pub radius: Vec<f32>,
+    pub(crate) radius: Vec<f32>,
     /// Representative area S (eqs. 4-6).
-    pub area: Vec<f64>,
+    pub(crate) area: Vec<f64>,
     /// Centroid of each sample's shares of area (its region): form factors are taken between
     /// region centroids, since a sample's radiosity stands for its region's average.
-    pub centroid: Vec<Vec3>,
+    pub(crate) centroid: Vec<Vec3>,
     /// The shares of area cells each sample holds (eq. 5): sample k's are
     /// `shares[share_start[k]..share_start[k+1]]`, each (cell index, area share). The shares of
     /// a cell add up to the cell, so they tile the surfaces exactly; near shooters are
     /// integrated over them.
-    pub shares: Vec<(u32, f32)>,
+    pub(crate) shares: Vec<(u32, f32)>,
     /// Offsets into `shares` (length samples + 1 once areas are computed).
-    pub share_start: Vec<u32>,
+    pub(crate) share_start: Vec<u32>,
     /// The area cells (pieces of surface).
-    pub cells: Vec<AreaCell>,
+    pub(crate) cells: Vec<AreaCell>,
     /// The adaptive round in which each sample was added (0 = initial Poisson disk).
-    pub round: Vec<u16>,
+    pub(crate) round: Vec<u16>,
 }
 
 impl Samples {
@@ -90,8 +91,50 @@ impl Samples {
         self.position.is_empty()
     }
 
+    /// Positions, on their surfaces.
+    pub fn position(&self) -> &[Vec3] {
+        &self.position
+    }
+
+    /// Unit normal of the side each sample is on.
+    pub fn normal(&self) -> &[Vec3] {
+        &self.normal
+    }
+
+    /// Influence radius D of each sample (eq. 3: ε initially; shrunk by adaptive rounds).
+    pub fn radius(&self) -> &[f32] {
+        &self.radius
+    }
+
+    /// Representative area S of each sample (eqs. 4-6).
+    pub fn area(&self) -> &[f64] {
+        &self.area
+    }
+
+    /// The adaptive round in which each sample was added (0 = initial Poisson disk).
+    pub fn round(&self) -> &[u16] {
+        &self.round
+    }
+
+    /// The scene surface sample k lies on (an index into [`Scene::surfaces`](crate::Scene)).
+    pub fn surface(&self, k: usize) -> u32 {
+        surface_of(self.side[k])
+    }
+
+    /// Whether sample k lies on the back of its surface (two-sided surfaces only).
+    pub fn is_back(&self, k: usize) -> bool {
+        is_back(self.side[k])
+    }
+
     /// Appends one sample (area 0 until areas are computed).
-    pub fn push(&mut self, maps: &[SurfaceMap], side: Side, uv: Vec2, radius: f32, round: u16) {
+    pub(crate) fn push(
+        &mut self,
+        maps: &[SurfaceMap],
+        side: Side,
+        uv: Vec2,
+        radius: f32,
+        round: u16,
+    ) {
         let map = &maps[surface_of(side) as usize];
         self.position.push(map.to_3d(uv));
         self.normal.push(if is_back(side) {
@@ -108,7 +151,7 @@ impl Samples {
     }
 
     /// Bytes the samples hold (their arrays' capacities), for the memory budget.
-    pub fn bytes(&self) -> usize {
+    pub(crate) fn bytes(&self) -> usize {
         vec_bytes(&self.position)
             + vec_bytes(&self.normal)
             + vec_bytes(&self.uv)
@@ -122,8 +165,9 @@ impl Samples {
             + vec_bytes(&self.round)
     }
 
-    /// Total area of the samples of each of `sides` sides (index: side id); an error if a
-    /// sample lies on a side beyond them.
+    /// Total area of the samples of each of `sides` sides (index: side id, `2 × surface` for
+    /// the front and `2 × surface + 1` for the back); an error if a sample lies on a side
+    /// beyond them.
     pub fn area_per_side(&self, sides: usize) -> crate::Result<Vec<f64>> {
         let mut total = vec![0.0; sides];
         for (&s, &a) in self.side.iter().zip(&self.area) {
@@ -155,11 +199,110 @@ pub struct AreaCell {
 
 impl Samples {
     /// Sample k's shares of area cells: (cell index, area).
-    pub fn shares_of(&self, k: usize) -> &[(u32, f32)] {
+    pub(crate) fn shares_of(&self, k: usize) -> &[(u32, f32)] {
         match (self.share_start.get(k), self.share_start.get(k + 1)) {
             (Some(&a), Some(&b)) => &self.shares[a as usize..b as usize],
             _ => &[],
         }
+    }
+
+    /// Checks the invariants the solver keeps (run in debug builds after every area
+    /// computation, and by tests): arrays of one length; samples of one side no closer than
+    /// the smaller of their radii (Poisson-disk spacing, eqs. 3 and 8); shares that point at
+    /// existing cells and split each cell exactly; every sampled side's areas summing to the
+    /// side's area; an index that finds every sample near itself. The first broken one, in
+    /// words.
+    pub(crate) fn validate(&self, maps: &[SurfaceMap], index: &SideIndex) -> Result<(), String> {
+        let n = self.len();
+        let lengths = [
+            ("normal", self.normal.len()),
+            ("uv", self.uv.len()),
+            ("side", self.side.len()),
+            ("radius", self.radius.len()),
+            ("area", self.area.len()),
+            ("centroid", self.centroid.len()),
+            ("round", self.round.len()),
+        ];
+        if let Some((name, len)) = lengths.iter().find(|(_, len)| *len != n) {
+            return Err(format!("{len} {name} entries for {n} samples"));
+        }
+        if let Some(k) = (0..n).find(|&k| self.side[k] as usize >= 2 * maps.len()) {
+            return Err(format!(
+                "sample {k} lies on side {}, beyond the scene",
+                self.side[k]
+            ));
+        }
+        // Spacing, found through the index (which must find each sample at its own place).
+        let mut near = Vec::new();
+        for k in 0..n {
+            let (side, uv, d) = (self.side[k], self.uv[k], self.radius[k]);
+            index.within(self, side, uv, d, &mut near);
+            if !near.iter().any(|&(j, _)| j as usize == k) {
+                return Err(format!(
+                    "the index does not find sample {k} at its own place"
+                ));
+            }
+            for &(j, d2) in &near {
+                let limit = d.min(self.radius[j as usize]) * (1.0 - 1e-3);
+                if j as usize != k && d2 < limit * limit {
+                    return Err(format!(
+                        "samples {k} and {j} lie {} apart, closer than their radii allow ({limit})",
+                        d2.sqrt()
+                    ));
+                }
+            }
+        }
+        if self.share_start.len() != n + 1 {
+            // Areas not computed yet: nothing more to check.
+            return Ok(());
+        }
+        if self.share_start.windows(2).any(|w| w[0] > w[1])
+            || self.share_start[n] as usize != self.shares.len()
+        {
+            return Err("share offsets out of order".into());
+        }
+        let mut per_cell = vec![0.0f64; self.cells.len()];
+        for k in 0..n {
+            let mut total = 0.0f64;
+            for &(c, a) in self.shares_of(k) {
+                let Some(cell) = self.cells.get(c as usize) else {
+                    return Err(format!(
+                        "sample {k} holds a share of cell {c}, which does not exist"
+                    ));
+                };
+                if cell.side != self.side[k] {
+                    return Err(format!(
+                        "sample {k} holds a share of a cell on another side"
+                    ));
+                }
+                per_cell[c as usize] += f64::from(a);
+                total += f64::from(a);
+            }
+            if (total - self.area[k]).abs() > 1e-4 * total.max(1e-30) {
+                return Err(format!(
+                    "sample {k}'s area {} is not its shares' {total}",
+                    self.area[k]
+                ));
+            }
+        }
+        for (c, (cell, &shared)) in self.cells.iter().zip(&per_cell).enumerate() {
+            let a = f64::from(cell.area);
+            if (shared - a).abs() > 1e-3 * a {
+                return Err(format!("cell {c} of area {a} is shared out as {shared}"));
+            }
+        }
+        let per_side = self
+            .area_per_side(2 * maps.len())
+            .map_err(|e| e.to_string())?;
+        for (side, &a) in per_side.iter().enumerate().filter(|(_, &a)| a > 0.0) {
+            let expected = maps[surface_of(side as u32) as usize].area();
+            if (a - expected).abs() > 1e-3 * expected {
+                return Err(format!(
+                    "side {side}'s samples carry {a} of its area {expected}"
+                ));
+            }
+        }
+        Ok(())
     }
 }
 

@@ -101,11 +101,6 @@ impl Obstruction {
         self.obstructed.get(side as usize).copied().unwrap_or(false)
     }
 
-    /// Number of obstructed sides.
-    pub fn count(&self) -> usize {
-        self.obstructed.iter().filter(|&&o| o).count()
-    }
-
     /// The segment between a point of a side and a sample, both lifted off the side.
     pub fn segment(&self, side_normal: Vec3, point: Vec3, samples: &Samples, k: u32) -> Segment {
         Segment {

@@ -163,23 +163,6 @@ impl SurfaceMap {
             .iter()
             .any(|&t| inside(&self.triangles[t as usize], p))
     }
-
-    /// Indices of triangles whose bounds overlap the box [lo, hi].
-    pub fn triangles_near(&self, lo: Vec2, hi: Vec2, out: &mut Vec<u32>) {
-        out.clear();
-        let (x0, y0) = self.cell_of(lo);
-        let (x1, y1) = self.cell_of(hi);
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                let c = y * self.nx + x;
-                out.extend_from_slice(
-                    &self.entries[self.starts[c] as usize..self.starts[c + 1] as usize],
-                );
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-    }
 }
 
 /// Area of a 2D triangle (unsigned).

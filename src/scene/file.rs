@@ -158,50 +158,16 @@ fn luminaire(
 
 /// A grid from its table, checked; `fail` names the table's line and the key at fault.
 fn grid(g: GridToml, fail: &dyn Fn(String) -> Error) -> Result<Grid> {
-    let (origin, u, v) = (Vec3::from(g.origin), Vec3::from(g.u), Vec3::from(g.v));
-    let name = &g.name;
-    for (key, value) in [("origin", origin), ("u", u), ("v", v)] {
-        if let Some(problem) = validate::position(value) {
-            return Err(fail(format!("grid '{name}': {key}: {problem}")));
-        }
-    }
-    for (key, edge) in [("u", u), ("v", v)] {
-        if edge.length_squared() <= 0.0 {
-            return Err(fail(format!("grid '{name}': {key} has zero length")));
-        }
-    }
-    let cross = u.cross(v);
-    if cross.length() <= 1e-6 * u.length() * v.length() {
-        return Err(fail(format!("grid '{name}': u {u} is parallel to v {v}")));
-    }
-    let normal = g.normal.map_or(cross, Vec3::from);
-    if !normal.is_finite() || normal.length_squared() <= 0.0 {
-        return Err(fail(format!(
-            "grid '{name}': normal {normal} is not a direction"
-        )));
-    }
-    let spacing = g.spacing.unwrap_or_else(|| Grid::default_spacing(u, v));
-    if !(spacing.is_finite() && spacing > 0.0) {
-        return Err(fail(format!(
-            "grid '{name}': spacing {spacing} must be a positive length"
-        )));
-    }
-    let Some((n_u, n_v)) = Grid::counts(u, v, spacing) else {
-        return Err(fail(format!(
-            "grid '{name}': spacing {spacing} would make more than {} points",
-            super::MAX_GRID_POINTS
-        )));
-    };
-    Ok(Grid {
-        name: g.name,
-        origin,
-        u,
-        v,
-        normal: normal.normalize(),
-        spacing,
-        n_u,
-        n_v,
-    })
+    let name = g.name.clone();
+    Grid::new(
+        g.name,
+        Vec3::from(g.origin),
+        Vec3::from(g.u),
+        Vec3::from(g.v),
+        g.normal.map(Vec3::from),
+        g.spacing,
+    )
+    .map_err(|problem| fail(format!("grid '{name}': {problem}")))
 }
 
 /// Reads and checks a scene file.

@@ -6,28 +6,104 @@ use glam::Vec3;
 /// The most points one grid may have.
 pub const MAX_GRID_POINTS: u64 = 10_000_000;
 
-/// A grid of measuring points: the centres of an n_u × n_v grid of equal cells.
+/// A grid of measuring points: the centres of an n_u × n_v grid of equal cells. Made by
+/// [`Grid::new`], which checks it; read through its accessors.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Grid {
-    /// Its name, unique in the scene.
-    pub name: String,
-    /// One corner.
-    pub origin: Vec3,
-    /// The first edge (direction and length).
-    pub u: Vec3,
-    /// The second edge.
-    pub v: Vec3,
-    /// The direction the measuring surface faces (unit length).
-    pub normal: Vec3,
-    /// The cell size asked for.
-    pub spacing: f32,
-    /// Cells along `u`: ⌈|u| / spacing⌉.
-    pub n_u: u32,
-    /// Cells along `v`.
-    pub n_v: u32,
+    pub(crate) name: String,
+    pub(crate) origin: Vec3,
+    pub(crate) u: Vec3,
+    pub(crate) v: Vec3,
+    pub(crate) normal: Vec3,
+    pub(crate) spacing: f32,
+    pub(crate) n_u: u32,
+    pub(crate) n_v: u32,
 }
 
 impl Grid {
+    /// A grid named `name` over the rectangle `origin` + s·u + t·v (s, t in [0, 1]), measuring
+    /// on a surface facing `normal` (default u × v), with cells of `spacing` (default
+    /// [`Grid::default_spacing`]). What is wrong, in words naming the key: a non-finite or
+    /// out-of-range corner or edge, an edge of zero length, parallel edges, a normal that is
+    /// no direction, a spacing that is not a positive length or makes more than
+    /// [`MAX_GRID_POINTS`] points.
+    pub fn new(
+        name: impl Into<String>,
+        origin: Vec3,
+        u: Vec3,
+        v: Vec3,
+        normal: Option<Vec3>,
+        spacing: Option<f32>,
+    ) -> Result<Grid, String> {
+        for (key, value) in [("origin", origin), ("u", u), ("v", v)] {
+            if let Some(problem) = super::validate::position(value) {
+                return Err(format!("{key}: {problem}"));
+            }
+        }
+        for (key, edge) in [("u", u), ("v", v)] {
+            if edge.length_squared() <= 0.0 {
+                return Err(format!("{key} has zero length"));
+            }
+        }
+        let cross = u.cross(v);
+        if cross.length() <= 1e-6 * u.length() * v.length() {
+            return Err(format!("u {u} is parallel to v {v}"));
+        }
+        let normal = normal.unwrap_or(cross);
+        if !normal.is_finite() || normal.length_squared() <= 0.0 {
+            return Err(format!("normal {normal} is not a direction"));
+        }
+        let spacing = spacing.unwrap_or_else(|| Grid::default_spacing(u, v));
+        if !(spacing.is_finite() && spacing > 0.0) {
+            return Err(format!("spacing {spacing} must be a positive length"));
+        }
+        let Some((n_u, n_v)) = Grid::counts(u, v, spacing) else {
+            return Err(format!(
+                "spacing {spacing} would make more than {MAX_GRID_POINTS} points"
+            ));
+        };
+        Ok(Grid {
+            name: name.into(),
+            origin,
+            u,
+            v,
+            normal: normal.normalize(),
+            spacing,
+            n_u,
+            n_v,
+        })
+    }
+
+    /// Its name, unique in the scene.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// One corner.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// The two edges (direction and length).
+    pub fn edges(&self) -> (Vec3, Vec3) {
+        (self.u, self.v)
+    }
+
+    /// The direction the measuring surface faces (unit length).
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    /// The cell size.
+    pub fn spacing(&self) -> f32 {
+        self.spacing
+    }
+
+    /// Cells (points) along each edge: ⌈|u| / spacing⌉ and ⌈|v| / spacing⌉.
+    pub fn counts_uv(&self) -> (u32, u32) {
+        (self.n_u, self.n_v)
+    }
+
     /// The default spacing from EN 12464-1 (as the spec gives it): p = 0.2 · 5^log10(d), d the
     /// longer edge.
     pub fn default_spacing(u: Vec3, v: Vec3) -> f32 {

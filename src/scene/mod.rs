@@ -1,6 +1,6 @@
 //! The scene: triangles grouped into planar surfaces, diffuse materials, area and point lights,
-//! and a camera, loaded from a scene file (TOML + OBJ/MTL, `shared/spec/scene-format.md`) or
-//! built from parts by a host program.
+//! and a camera, loaded from a scene file (TOML + OBJ/MTL, `docs/scene-format.md`) or built
+//! from parts by a host program.
 
 mod camera;
 mod file;
@@ -217,38 +217,149 @@ pub struct SceneParts {
     pub solver: SolverDefaults,
 }
 
-/// A loaded, validated scene.
+/// A loaded, validated scene. Read through its accessors; the few things a host may change
+/// after loading (camera, materials, grids) go through setters that check them.
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// Where it came from: the scene file, or the name a host program gave.
-    pub path: PathBuf,
+    pub(crate) path: PathBuf,
     /// Materials, indexed by [`Surface::material`].
-    pub materials: Vec<Material>,
+    pub(crate) materials: Vec<Material>,
     /// Triangles, ordered so that each surface's triangles are contiguous.
-    pub triangles: Vec<Triangle>,
+    pub(crate) triangles: Vec<Triangle>,
     /// Planar surfaces.
-    pub surfaces: Vec<Surface>,
+    pub(crate) surfaces: Vec<Surface>,
     /// Point lights.
-    pub point_lights: Vec<PointLight>,
+    pub(crate) point_lights: Vec<PointLight>,
     /// Luminaires (IES distributions) from the scene file.
-    pub luminaires: Vec<Luminaire>,
+    pub(crate) luminaires: Vec<Luminaire>,
     /// The scene's units: what its numbers mean, and what results are reported in.
-    pub units: Units,
+    pub(crate) units: Units,
     /// Calculation surfaces where `meshlight lux` measures illuminance.
-    pub grids: Vec<Grid>,
+    pub(crate) grids: Vec<Grid>,
     /// The camera.
-    pub camera: Camera,
+    pub(crate) camera: Camera,
     /// Whether non-emitting faces reflect on both sides.
-    pub two_sided: bool,
+    pub(crate) two_sided: bool,
     /// Solver defaults from the scene file.
-    pub solver: SolverDefaults,
+    pub(crate) solver: SolverDefaults,
     /// Bounds of all triangles.
-    pub bounds: Bounds,
+    pub(crate) bounds: Bounds,
     /// Things worth telling the user that did not stop loading (each said once).
-    pub warnings: Vec<String>,
+    pub(crate) warnings: Vec<String>,
 }
 
 impl Scene {
+    /// Where it came from: the scene file, or the name a host program gave.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Materials, indexed by [`Surface::material`].
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Triangles, ordered so that each surface's triangles are contiguous.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// Planar surfaces.
+    pub fn surfaces(&self) -> &[Surface] {
+        &self.surfaces
+    }
+
+    /// Point lights.
+    pub fn point_lights(&self) -> &[PointLight] {
+        &self.point_lights
+    }
+
+    /// Luminaires (IES distributions) from the scene file.
+    pub fn luminaires(&self) -> &[Luminaire] {
+        &self.luminaires
+    }
+
+    /// The scene's units: what its numbers mean, and what results are reported in.
+    pub fn units(&self) -> Units {
+        self.units
+    }
+
+    /// Calculation surfaces where illuminance is measured.
+    pub fn grids(&self) -> &[Grid] {
+        &self.grids
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Whether non-emitting faces reflect on both sides.
+    pub fn two_sided(&self) -> bool {
+        self.two_sided
+    }
+
+    /// Solver defaults from the scene file.
+    pub fn solver_defaults(&self) -> &SolverDefaults {
+        &self.solver
+    }
+
+    /// Bounds of all triangles.
+    pub fn bounds(&self) -> Bounds {
+        self.bounds
+    }
+
+    /// Things worth telling the user that did not stop loading (each said once).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Looks through another camera (the same checks as a scene file's `[camera]`).
+    pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        if let Some(problem) = camera.problem() {
+            return Err(Error::argument("camera", problem));
+        }
+        self.camera = camera;
+        Ok(())
+    }
+
+    /// Replaces material `index` (the same checks as an MTL file's). Whether it emits decides
+    /// whether its surfaces reflect on both sides in a two-sided scene, so that follows.
+    pub fn set_material(&mut self, index: usize, material: Material) -> Result<()> {
+        if index >= self.materials.len() {
+            return Err(Error::argument(
+                "material",
+                format!(
+                    "index {index} is out of range ({} materials)",
+                    self.materials.len()
+                ),
+            ));
+        }
+        if let Some((_, problem)) = validate::material_field(&material) {
+            return Err(Error::argument("material", problem));
+        }
+        for surface in self.surfaces.iter_mut() {
+            if surface.material as usize == index {
+                surface.two_sided = self.two_sided && !material.is_emitter();
+            }
+        }
+        self.materials[index] = material;
+        Ok(())
+    }
+
+    /// Adds a calculation grid; its name must be new to the scene.
+    pub fn add_grid(&mut self, grid: Grid) -> Result<()> {
+        if self.grids.iter().any(|g| g.name == grid.name) {
+            return Err(Error::argument(
+                "grid",
+                format!("the name '{}' is taken", grid.name),
+            ));
+        }
+        self.grids.push(grid);
+        Ok(())
+    }
+
     /// Loads a scene file (TOML) and the OBJ/MTL it points at.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
         Scene::load_from(&Disk, path)
@@ -458,8 +569,8 @@ impl Scene {
         Ok(scene)
     }
 
-    /// The material of a surface.
-    pub fn material_of(&self, surface: u32) -> &Material {
+    /// The material of a surface (`surface` below `surfaces().len()`).
+    pub(crate) fn material_of(&self, surface: u32) -> &Material {
         &self.materials[self.surfaces[surface as usize].material as usize]
     }
 

@@ -434,7 +434,7 @@ fn materials_from(
             material.kd = Vec3::from(kd.to_array().map(|c| if c == 1.0 { r } else { c }));
             warnings.push(format!(
                 "{}:{}: {said}: a channel of 1 reflects all light, which nothing real does: \
-                 lowered to {r} (max_reflectance; --strict refuses it)",
+                 lowered to {r} (max_reflectance; strict loading refuses it)",
                 path.display(),
                 at_kd.unwrap_or(at.line),
             ));

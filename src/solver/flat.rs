@@ -27,9 +27,9 @@ use crate::visibility::Visibility;
 use super::form_factor::{segment, Shooter};
 use super::normalise::row_scale;
 use super::pipeline::with_pool;
-use super::progress::Control;
 use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
+use crate::progress::Control;
 
 /// Visibility already known: row j holds, once sample j has shot, which samples see it.
 /// Written by the coordinator between shots, read by workers during them (the channel hand-off

@@ -14,7 +14,6 @@ mod normalise;
 mod options;
 mod phases;
 mod pipeline;
-mod progress;
 mod shooting;
 mod stats;
 mod warm;
@@ -23,44 +22,37 @@ use std::time::Instant;
 
 use glam::DVec3;
 
+pub use crate::area::AreaStats;
+use crate::budget::{human_bytes, BYTES_PER_SAMPLE};
 use crate::error::{Error, Result};
-use crate::light::{Arrival, DirectLight};
-use crate::sampling::{reflecting_sides, surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
+pub use crate::light::Arrival;
+use crate::light::DirectLight;
+use crate::progress::Reporter;
+pub use crate::progress::{Control, Phase, Progress};
+pub use crate::sampling::Samples;
+use crate::sampling::{reflecting_sides, surface_of, Obstruction, SideIndex, SurfaceMap};
 use crate::scene::Scene;
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
-pub use options::{
-    Options, Preset, AUTO_SAMPLES, BYTES_PER_SAMPLE, DEFAULT_CLUSTER_THRESHOLD,
-    DEFAULT_MEMORY_BUDGET,
-};
+pub use options::{Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD};
 use phases::{AddedSamples, Solve};
-pub use progress::{Control, Phase, Progress};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
 pub(crate) use warm::emission as emission_of;
 pub(crate) use warm::reflectance as reflectance_of;
 use warm::reflectance;
 
-/// The solved samples.
+/// The solved samples: read-only results (the solver alone builds one).
 #[derive(Clone, Debug)]
 pub struct Solution {
-    /// The samples (positions, normals, sides, radii, areas).
-    pub samples: Samples,
-    /// Radiosity B of each sample (W/m², RGB): emission π·Ke plus reflected light.
-    pub radiosity: Vec<DVec3>,
-    /// Irradiance at each sample (direct + inter-reflected).
-    pub irradiance: Vec<DVec3>,
-    /// Unshot radiosity left.
-    pub unshot: Vec<DVec3>,
-    /// Direct light at each sample.
-    pub direct: Vec<Arrival>,
-    /// ε used.
-    pub epsilon: f32,
-    /// Where ε came from.
-    pub epsilon_source: EpsilonSource,
-    /// Every round, in order.
-    pub rounds: Vec<RoundStats>,
-    /// Energy bookkeeping.
-    pub ledger: EnergyLedger,
+    pub(crate) samples: Samples,
+    pub(crate) radiosity: Vec<DVec3>,
+    pub(crate) irradiance: Vec<DVec3>,
+    pub(crate) unshot: Vec<DVec3>,
+    pub(crate) direct: Vec<Arrival>,
+    pub(crate) epsilon: f32,
+    pub(crate) epsilon_source: EpsilonSource,
+    pub(crate) rounds: Vec<RoundStats>,
+    pub(crate) ledger: EnergyLedger,
     // What the solver and renderer need beyond the results: kept with them, not shown.
     /// The surfaces in 2D (for interpolation).
     pub(crate) maps: Vec<SurfaceMap>,
@@ -77,6 +69,53 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// The samples (positions, normals, sides, radii, areas).
+    pub fn samples(&self) -> &Samples {
+        &self.samples
+    }
+
+    /// Radiosity B of each sample (W/m², RGB): emission π·Ke plus reflected light.
+    pub fn radiosity(&self) -> &[DVec3] {
+        &self.radiosity
+    }
+
+    /// Irradiance at each sample (direct + inter-reflected).
+    pub fn irradiance(&self) -> &[DVec3] {
+        &self.irradiance
+    }
+
+    /// Unshot radiosity left at each sample.
+    pub fn unshot(&self) -> &[DVec3] {
+        &self.unshot
+    }
+
+    /// Direct light at each sample.
+    pub fn direct(&self) -> &[Arrival] {
+        &self.direct
+    }
+
+    /// The Poisson-disk spacing ε used.
+    pub fn epsilon(&self) -> f32 {
+        self.epsilon
+    }
+
+    /// Where ε came from.
+    pub fn epsilon_source(&self) -> EpsilonSource {
+        self.epsilon_source
+    }
+
+    /// Every round, in order.
+    pub fn rounds(&self) -> &[RoundStats] {
+        &self.rounds
+    }
+
+    /// Where the emitted energy went.
+    pub fn ledger(&self) -> &EnergyLedger {
+        &self.ledger
+    }
+}
+
+impl Solution {
     /// Per sample: whether all its probe rays met the scene (a closed hemisphere), where its
     /// form factors are normalised (diagnostics).
     pub fn closed(&self) -> &[bool] {
@@ -87,11 +126,6 @@ impl Solution {
     /// where the hemisphere is closed (diagnostics: the raw sums are what the furnace checks).
     pub fn row_scales(&self) -> &[f32] {
         &self.row_scale
-    }
-
-    /// The surfaces in 2D the samples live in, one per scene surface.
-    pub fn surface_maps(&self) -> &[SurfaceMap] {
-        &self.maps
     }
 
     /// Bytes the solution holds: samples, their index, and per-sample results (the part of
@@ -112,6 +146,13 @@ impl Solution {
                 .iter()
                 .map(|m| vec_bytes(&m.triangles))
                 .sum::<usize>()
+    }
+
+    /// Checks the samples' invariants (see the crate's docs: Poisson-disk spacing, areas that
+    /// tile every sampled side, consistent shares and index): the first one broken, in words.
+    /// The solver checks them itself in debug builds.
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        self.samples.validate(&self.maps, &self.index)
     }
 
     /// Whether this solution belongs to `scene` and its arrays agree with each other: an
@@ -150,6 +191,20 @@ impl Solution {
         }
         if !self.index.fits(sides, n) {
             return fail("its sample index does not match its samples".into());
+        }
+        // The samples lie on their surfaces' planes (a solution of the scene at another scale or
+        // place has every count right and every sample off).
+        let tolerance = 1e-4 * scene.bounds.diagonal();
+        for k in 0..n {
+            let surface = &scene.surfaces[surface_of(s.side[k]) as usize];
+            let off = surface.normal.dot(s.position[k]) - surface.offset;
+            if !(off.abs() <= tolerance) {
+                return fail(format!(
+                    "sample {k} at {} does not lie on surface {} (it is {off} off its plane)",
+                    s.position[k],
+                    surface_of(s.side[k])
+                ));
+            }
         }
         Ok(())
     }
@@ -268,7 +323,7 @@ fn solve_with(
     scene: &Scene,
     vis: &dyn Visibility,
     options: &Options,
-    progress: &mut dyn FnMut(&Progress) -> Control,
+    progress: crate::progress::Callback,
     method: Method,
 ) -> Result<Solution> {
     check(options)?;
@@ -279,23 +334,22 @@ fn solve_with(
             option: "epsilon",
             problem: format!(
                 "ε = {epsilon} would place about {predicted:.0} samples, more than the limit of {} \
-                 (raise --max-samples or choose a larger ε)",
+                 (raise max_samples or choose a larger ε)",
                 options.max_samples
             ),
         });
     }
     let predicted_bytes = predicted * BYTES_PER_SAMPLE as f64;
     if predicted_bytes > options.memory_budget as f64 / 2.0 {
-        return Err(Error::Option {
-            option: "memory_budget",
-            problem: format!(
+        return Err(crate::budget::exceeded(
+            options.memory_budget,
+            format!(
                 "ε = {epsilon} would place about {predicted:.0} samples, predicted to take {} \
-                 ({BYTES_PER_SAMPLE} bytes each), more than half the memory budget of {} (the \
-                 other half is for links and caches; raise --memory-budget or choose a larger ε)",
+                 ({BYTES_PER_SAMPLE} bytes each), more than half the budget (the other half is \
+                 for links and caches): raise the budget or choose a larger ε",
                 human_bytes(predicted_bytes),
-                human_bytes(options.memory_budget as f64)
             ),
-        });
+        ));
     }
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
@@ -308,7 +362,7 @@ fn solve_with(
         grid: (method == Method::Hierarchy).then(|| TriangleGrid::new(scene)),
         lift,
         epsilon,
-        progress,
+        reporter: Reporter::new(progress),
     };
 
     // Round 0: Poisson disk on every reflecting side.
@@ -385,22 +439,6 @@ pub fn transfer(
     })
 }
 
-/// Bytes in binary units, for messages: "3.2 GiB".
-pub fn human_bytes(bytes: f64) -> String {
-    const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
-    let mut value = bytes;
-    let mut unit = 0;
-    while value >= 1024.0 && unit + 1 < UNITS.len() {
-        value /= 1024.0;
-        unit += 1;
-    }
-    if unit == 0 {
-        format!("{value:.0} bytes")
-    } else {
-        format!("{value:.1} {}", UNITS[unit])
-    }
-}
-
 fn check(options: &Options) -> Result<()> {
     let fail = |option, problem: String| Err(Error::Option { option, problem });
     if !(options.alpha.is_finite() && options.alpha >= 0.0) {
@@ -423,7 +461,7 @@ fn check(options: &Options) -> Result<()> {
     }
     if options.light_samples == 0 || options.light_samples > crate::light::MAX_LIGHT_SAMPLES {
         return fail(
-            "light-samples",
+            "light_samples",
             format!(
                 "{} must lie in 1..={}",
                 options.light_samples,
@@ -433,7 +471,7 @@ fn check(options: &Options) -> Result<()> {
     }
     if !(options.cluster_threshold.is_finite() && options.cluster_threshold >= 0.0) {
         return fail(
-            "cluster-threshold",
+            "cluster_threshold",
             format!(
                 "{} must be a finite number ≥ 0 (0: the flat solver)",
                 options.cluster_threshold

@@ -1,7 +1,9 @@
 //! Every knob of the solver in one documented struct, with named presets.
 
+use crate::budget::DEFAULT_MEMORY_BUDGET;
+
 /// Solver settings. Each field says what it does, its useful range, and its effect on error and
-/// time; `docs` measurements are in the README.
+/// time; the measurements are in `docs/performance.md`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// ε, the Poisson-disk spacing of the initial samples (scene units). `None`: the scene
@@ -19,7 +21,7 @@ pub struct Options {
     /// the error exceeds ζ and solves again from the previous solution.
     pub rounds: u32,
     /// Shadow rays per area light and sample, useful 4–256: more gives smoother penumbrae at
-    /// proportional direct-light cost; at most [`crate::light::MAX_LIGHT_SAMPLES`]. Unused
+    /// proportional direct-light cost; at most [`crate::MAX_LIGHT_SAMPLES`]. Unused
     /// without area lights.
     pub light_samples: u32,
     /// Shooting stops when the unshot power falls below this fraction of the emitted power,
@@ -41,12 +43,12 @@ pub struct Options {
     /// partly visible link whose whole transfer is below a quarter of the error threshold
     /// carries the visible share its probes measured (no wall is ever crossed: clusters never
     /// straddle an occluder). Exact visibility sharpens faint penumbrae at a cost that grows
-    /// faster than the samples: on the shipped gallery 3.7 s instead of 3.1 s for about the
-    /// same error against the flat solve (MAE/mean 0.22% and 0.21%); at 179k samples 98 M
-    /// links and 2.6 GB instead of 5.1 M and 0.7 GB (README).
+    /// faster than the samples: on the shipped gallery 3.95 s instead of 3.26 s for about the
+    /// same error against the flat solve (MAE/mean 0.21% and 0.20%); at 179k samples 97.6 M
+    /// links and 2.57 GB instead of 5.1 M and 0.71 GB (`docs/performance.md`).
     pub exact_visibility: bool,
     /// The memory budget, bytes: every large structure counts against it. The samples and
-    /// their results are predicted before they are placed ([`BYTES_PER_SAMPLE`] each) and a
+    /// their results are predicted before they are placed ([`BYTES_PER_SAMPLE`](crate::budget::BYTES_PER_SAMPLE) each) and a
     /// solve that would not fit is refused before allocating; adaptive rounds stop adding
     /// samples at half of it; the rest is for the hierarchy's links (a solve whose links
     /// outgrow it ends with an error) or the flat solver's visibility memo (N²/8 bytes, left
@@ -64,15 +66,6 @@ pub struct Options {
 
 /// Initial sample count the automatic ε aims at.
 pub const AUTO_SAMPLES: f64 = 4000.0;
-
-/// The default [`Options::memory_budget`]: 8 GiB, a third of this project's 24 GiB test
-/// machine: half of it holds about 1.4 million samples at [`BYTES_PER_SAMPLE`].
-pub const DEFAULT_MEMORY_BUDGET: usize = 8 << 30;
-
-/// Bytes a sample is budgeted at before it is placed: its arrays, area cells and shares,
-/// index entries and results. `Solution::bytes` / samples measured 1,420–1,950 on the shipped
-/// scenes at the defaults (vectors grown by doubling hold up to twice what they use).
-pub const BYTES_PER_SAMPLE: usize = 3072;
 
 /// The default [`Options::cluster_threshold`].
 pub const DEFAULT_CLUSTER_THRESHOLD: f64 = 0.05;

@@ -10,39 +10,18 @@ use super::cluster::coherence::{Context, TriangleGrid};
 use super::shooting::{Settings, State, Tick};
 use super::warm::{emission, reflectance};
 use super::{cluster, flat, normalise, warm};
-use super::{Control, Options, Phase, PhaseSeconds, Progress, RoundStats, Solution};
-use crate::area;
+use super::{Options, PhaseSeconds, RoundStats, ShootStats, Solution, StopReason};
+use crate::area::{self, AreaStats};
 use crate::error::Result;
-use crate::light::DirectLight;
-use crate::parallel::for_chunks;
+use crate::light::{Arrival, DirectLight};
+use crate::parallel::for_chunks_reporting;
+use crate::progress::{Control, Phase, Progress, Reporter};
 use crate::sampling::adaptive::{self, RefineSettings};
 use crate::sampling::{
     cover, poisson, reflecting_sides, surface_of, Samples, SideIndex, SurfaceMap,
 };
 use crate::scene::Scene;
 use crate::visibility::Visibility;
-
-/// A reporter for a phase of a round: hears the share done, tells the host (stopping is
-/// honoured at shots and round boundaries only).
-pub(super) fn reporter<'a>(
-    progress: &'a mut dyn FnMut(&Progress) -> Control,
-    phase: Phase,
-    round: u32,
-    samples: usize,
-    tolerance: f64,
-) -> impl FnMut(f64) + 'a {
-    move |fraction| {
-        let _ = progress(&Progress {
-            phase,
-            round,
-            samples,
-            shots: 0,
-            unshot_fraction: 1.0,
-            tolerance,
-            fraction,
-        });
-    }
-}
 
 /// What one solve holds across its rounds.
 pub(super) struct Solve<'a> {
@@ -54,7 +33,7 @@ pub(super) struct Solve<'a> {
     pub(super) grid: Option<TriangleGrid>,
     pub(super) lift: f32,
     pub(super) epsilon: f32,
-    pub(super) progress: &'a mut dyn FnMut(&Progress) -> Control,
+    pub(super) reporter: Reporter<'a>,
 }
 
 /// Samples an adaptive step (or the initial placement) added.
@@ -69,36 +48,47 @@ pub(super) struct AddedSamples {
 }
 
 impl Solve<'_> {
-    fn report(&mut self, phase: Phase, round: u32, samples: usize, tick: Option<Tick>) -> Control {
-        let tick = tick.unwrap_or(Tick {
-            phase,
-            shots: 0,
-            unshot_fraction: 1.0,
-            fraction: 0.0,
-        });
-        (self.progress)(&Progress {
-            phase: tick.phase,
+    /// The report of `phase` in `round` over `samples` samples, nothing done yet.
+    fn base(&self, phase: Phase, round: u32, samples: usize) -> Progress {
+        Progress {
             round,
-            samples,
-            shots: tick.shots,
-            unshot_fraction: tick.unshot_fraction,
+            items: samples,
             tolerance: self.options.tolerance,
-            fraction: tick.fraction,
-        })
+            unshot_fraction: 1.0,
+            ..Progress::of(phase)
+        }
     }
 
-    /// Poisson-disk samples on every reflecting side (eq. 3), each side seeded on its own.
+    /// Tells the host a phase starts; whether to stop.
+    fn begin(&mut self, phase: Phase, round: u32, samples: usize) -> bool {
+        let base = self.base(phase, round, samples);
+        self.reporter.report(base)
+    }
+
+    /// Poisson-disk samples on every reflecting side (eq. 3), each side seeded on its own. A
+    /// Stop leaves the sides not reached yet without samples.
     pub(super) fn initial_samples(&mut self, maps: &[SurfaceMap]) -> Result<Samples> {
-        // Stopping is honoured from the first shot on: before it there is no estimate to return.
-        let _ = self.report(Phase::Sampling, 0, 0, None);
+        self.begin(Phase::Sampling, 0, 0);
         let sides = reflecting_sides(self.scene);
         let mut per_side: Vec<Vec<glam::Vec2>> = vec![Vec::new(); sides.len()];
         let (epsilon, seed) = (self.epsilon, self.options.seed);
-        for_chunks(&mut per_side, 1, self.options.threads.max(1), |i, out| {
-            let side = sides[i];
-            out[0] = poisson::sample_side(&maps[surface_of(side) as usize], side, epsilon, seed);
-            Ok(())
-        })?;
+        let threads = self.options.threads.max(1);
+        if !self.reporter.stopped() {
+            let base = self.base(Phase::Sampling, 0, 0);
+            let place = |i: usize, out: &mut [Vec<glam::Vec2>]| {
+                let side = sides[i];
+                out[0] =
+                    poisson::sample_side(&maps[surface_of(side) as usize], side, epsilon, seed);
+                Ok(())
+            };
+            for_chunks_reporting(
+                &mut per_side,
+                1,
+                threads,
+                place,
+                &mut self.reporter.part(base),
+            )?;
+        }
         let mut samples = Samples::default();
         for (&side, points) in sides.iter().zip(&per_side) {
             for &p in points {
@@ -109,15 +99,15 @@ impl Solve<'_> {
     }
 
     /// One round: areas over all samples, direct light and a warm start for the new ones,
-    /// then shooting.
+    /// the probes behind the row scales, then shooting. After a Stop the remaining phases are
+    /// skipped, leaving a consistent solution: new samples without direct light or probes,
+    /// and no shooting.
     pub(super) fn round(
         &mut self,
         solution: &mut Solution,
         round: u32,
         added: &AddedSamples,
     ) -> Result<RoundStats> {
-        let (scene, vis, options) = (self.scene, self.vis, self.options);
-        let threads = options.threads.max(1);
         let mut seconds = PhaseSeconds {
             sampling: added.seconds,
             ..PhaseSeconds::default()
@@ -125,54 +115,110 @@ impl Solve<'_> {
         let n = solution.samples.len();
         let first_new = n - added.added;
 
-        // Areas over all samples, old and new.
         let t = Instant::now();
-        let _ = self.report(Phase::Areas, round, n, None);
+        let area_stats = self.areas(solution, round, added)?;
+        seconds.areas = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        let direct_queries = self.direct_light(solution, round, first_new)?;
+        seconds.direct = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        self.row_scales(solution, round, first_new)?;
+        let probe_seconds = t.elapsed().as_secs_f64();
+
+        let solution_bytes = solution.bytes();
+        let t = Instant::now();
+        let (shooting, link_seconds) = self.shoot(solution, round, solution_bytes)?;
+        let total = t.elapsed().as_secs_f64();
+        let linking = link_seconds.unwrap_or(total);
+        if self.grid.is_some() {
+            seconds.links = linking + probe_seconds;
+            seconds.shooting = total - linking;
+        } else {
+            seconds.shooting = total + probe_seconds;
+        }
+        for k in 0..n {
+            solution.radiosity[k] = emission(self.scene, &solution.samples, k)
+                + reflectance(self.scene, &solution.samples, k) * solution.irradiance[k];
+        }
+        Ok(RoundStats {
+            round,
+            samples: n,
+            added: added.added,
+            refined: added.refined,
+            capped: added.capped,
+            solution_bytes: solution_bytes as u64,
+            direct_queries,
+            areas: area_stats,
+            shooting,
+            seconds,
+        })
+    }
+
+    /// Representative areas over all samples, old and new (eqs. 4-6).
+    fn areas(
+        &mut self,
+        solution: &mut Solution,
+        round: u32,
+        added: &AddedSamples,
+    ) -> Result<AreaStats> {
+        let n = solution.samples.len();
+        self.begin(Phase::Areas, round, n);
         solution.index = SideIndex::new(&solution.samples, &solution.maps, self.epsilon);
-        let area_stats = area::compute(
+        let base = self.base(Phase::Areas, round, n);
+        let stats = area::compute(
             &mut solution.samples,
             &solution.maps,
             &solution.index,
             &solution.obstruction,
-            vis,
-            (self.epsilon, options.alpha),
-            threads,
+            self.vis,
+            (self.epsilon, self.options.alpha),
+            self.options.threads.max(1),
             added.changed.as_deref(),
-            &mut reporter(
-                &mut *self.progress,
-                Phase::Areas,
-                round,
-                n,
-                options.tolerance,
-            ),
+            &mut self.reporter.part(base),
         )?;
-        seconds.areas = t.elapsed().as_secs_f64();
+        debug_assert_eq!(solution.validate(), Ok(()));
+        Ok(stats)
+    }
 
-        // Direct light at the new samples.
-        let t = Instant::now();
-        let _ = self.report(Phase::DirectLight, round, n, None);
+    /// Direct light at the new samples, whether something covers them, and their warm start;
+    /// the shadow queries made.
+    fn direct_light(
+        &mut self,
+        solution: &mut Solution,
+        round: u32,
+        first_new: usize,
+    ) -> Result<u64> {
+        let (scene, vis, options) = (self.scene, self.vis, self.options);
+        let threads = options.threads.max(1);
+        let n = solution.samples.len();
+        self.begin(Phase::DirectLight, round, n);
         let s = &solution.samples;
         let points: Vec<(Vec3, Vec3)> = (first_new..n)
             .map(|k| (s.position[k], s.normal[k]))
             .collect();
         let ids: Vec<u32> = (first_new as u32..n as u32).collect();
-        let (arrivals, direct_queries) = self.light.at(
-            vis,
-            &points,
-            &ids,
-            options.seed,
-            threads,
-            &mut reporter(
-                &mut *self.progress,
-                Phase::DirectLight,
-                round,
-                n,
-                options.tolerance,
-            ),
-        )?;
-        let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
+        let (arrivals, queries, covered) = if self.reporter.stopped() {
+            (
+                vec![Arrival::default(); points.len()],
+                0,
+                vec![false; points.len()],
+            )
+        } else {
+            let base = self.base(Phase::DirectLight, round, n);
+            let (arrivals, queries) = self.light.at(
+                vis,
+                &points,
+                &ids,
+                options.seed,
+                threads,
+                &mut self.reporter.part(base),
+            )?;
+            let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
+            (arrivals, queries, covered)
+        };
         solution.covered.extend(covered);
-        seconds.direct = t.elapsed().as_secs_f64();
         warm::start(
             scene,
             solution,
@@ -190,30 +236,34 @@ impl Solve<'_> {
                 .sum();
             solution.ledger.escaped += solution.ledger.emitted - received;
         }
+        Ok(queries)
+    }
 
-        // Which new samples see the scene all around (for the row scales).
-        let t = Instant::now();
+    /// Which new samples see the scene all around (the probes behind the row scales), and the
+    /// row scales the new samples start from.
+    fn row_scales(&mut self, solution: &mut Solution, round: u32, first_new: usize) -> Result<()> {
+        let scene = self.scene;
+        let n = solution.samples.len();
         let sides = reflecting_sides(scene);
         let mut reflecting = vec![false; 2 * scene.surfaces.len()];
         for &side in &sides {
             reflecting[side as usize] = true;
         }
-        let probes = normalise::closed_hemispheres(
-            scene,
-            &reflecting,
-            &solution.samples,
-            first_new,
-            vis,
-            (options.seed, threads),
-            self.lift,
-            &mut reporter(
-                &mut *self.progress,
-                Phase::Links,
-                round,
-                n,
-                options.tolerance,
-            ),
-        )?;
+        let probes = if self.reporter.stopped() {
+            vec![false; n - first_new]
+        } else {
+            let base = self.base(Phase::Links, round, n);
+            normalise::closed_hemispheres(
+                scene,
+                &reflecting,
+                &solution.samples,
+                first_new,
+                self.vis,
+                (self.options.seed, self.options.threads.max(1)),
+                self.lift,
+                &mut self.reporter.part(base),
+            )?
+        };
         solution.closed.extend(probes);
         let hierarchical = self.grid.is_some();
         for k in first_new..n {
@@ -234,12 +284,25 @@ impl Solve<'_> {
             };
             solution.row_scale.push(scale);
         }
-        let probe_seconds = t.elapsed().as_secs_f64();
+        Ok(())
+    }
 
-        // Shoot, with what the samples leave of the memory budget.
-        let solution_bytes = solution.bytes();
-        let memory_left = options.memory_budget.saturating_sub(solution_bytes);
-        let t = Instant::now();
+    /// Shoots (flat or clustered) with what the samples leave of the memory budget; the stats
+    /// and, for the hierarchy, the seconds its links took.
+    fn shoot(
+        &mut self,
+        solution: &mut Solution,
+        round: u32,
+        solution_bytes: usize,
+    ) -> Result<(ShootStats, Option<f64>)> {
+        let (scene, vis, options) = (self.scene, self.vis, self.options);
+        let n = solution.samples.len();
+        if self.reporter.stopped() {
+            let mut stats = ShootStats::new();
+            stats.stop = StopReason::Stopped;
+            return Ok((stats, None));
+        }
+        let hierarchical = self.grid.is_some();
         let reflectances: Vec<DVec3> = (0..n)
             .map(|k| reflectance(scene, &solution.samples, k))
             .collect();
@@ -257,7 +320,7 @@ impl Solve<'_> {
             dark_emitters: &dark_emitters,
         };
         let settings = Settings {
-            threads,
+            threads: options.threads.max(1),
             capacity: options.pipeline_capacity.max(1),
             tolerance: options.tolerance,
             max_shots: options.max_shots.unwrap_or(if hierarchical {
@@ -266,28 +329,35 @@ impl Solve<'_> {
                 200 * n as u64
             }),
             lift: self.lift,
-            memory_bytes: memory_left,
+            memory_bytes: options.memory_budget.saturating_sub(solution_bytes),
+            budget: options.memory_budget,
             normalise: round == 0 || hierarchical,
             threshold: options.cluster_threshold,
             exact_visibility: options.exact_visibility,
             seed: options.seed,
         };
-        let progress = &mut *self.progress;
         let mut link_seconds = None;
         let link_start = Instant::now();
+        let reporter = &mut self.reporter;
         let mut report = |tick: Tick| {
             if tick.phase == Phase::Shooting && link_seconds.is_none() {
                 link_seconds = Some(link_start.elapsed().as_secs_f64());
             }
-            progress(&Progress {
+            let stop = reporter.report(Progress {
                 phase: tick.phase,
                 round,
-                samples: n,
+                items: n,
                 shots: tick.shots,
                 unshot_fraction: tick.unshot_fraction,
                 tolerance: options.tolerance,
                 fraction: tick.fraction,
-            })
+                ..Progress::of(tick.phase)
+            });
+            if stop {
+                Control::Stop
+            } else {
+                Control::Continue
+            }
         };
         let shooting = match &self.grid {
             Some(grid) => {
@@ -302,30 +372,7 @@ impl Solve<'_> {
             }
             None => flat::shoot(&mut state, vis, &settings, &mut report)?,
         };
-        let total = t.elapsed().as_secs_f64();
-        let linking = link_seconds.unwrap_or(total);
-        if hierarchical {
-            seconds.links = linking + probe_seconds;
-            seconds.shooting = total - linking;
-        } else {
-            seconds.shooting = total + probe_seconds;
-        }
-        for (k, rho) in reflectances.iter().enumerate() {
-            solution.radiosity[k] =
-                emission(scene, &solution.samples, k) + *rho * solution.irradiance[k];
-        }
-        Ok(RoundStats {
-            round,
-            samples: n,
-            added: added.added,
-            refined: added.refined,
-            capped: added.capped,
-            solution_bytes: solution_bytes as u64,
-            direct_queries,
-            areas: area_stats,
-            shooting,
-            seconds,
-        })
+        Ok((shooting, link_seconds))
     }
 
     /// Adds samples where the error is large (eqs. 7-8), unless told to stop.
@@ -335,12 +382,13 @@ impl Solve<'_> {
         round: u32,
     ) -> Result<Option<AddedSamples>> {
         let t = Instant::now();
-        if self.report(Phase::Adaptive, round, solution.samples.len(), None) == Control::Stop {
+        if self.begin(Phase::Adaptive, round, solution.samples.len()) {
             return Ok(None);
         }
         let options = self.options;
         let n = solution.samples.len();
         let radii = solution.samples.radius.clone();
+        let base = self.base(Phase::Adaptive, round, n);
         let refinement = adaptive::refine(
             &mut solution.samples,
             &solution.maps,
@@ -358,16 +406,13 @@ impl Solve<'_> {
                 // Half the budget for the samples, the rest for links and caches.
                 max_samples: options
                     .max_samples
-                    .min(options.memory_budget / 2 / super::BYTES_PER_SAMPLE),
+                    .min(options.memory_budget / 2 / crate::budget::BYTES_PER_SAMPLE),
             },
-            &mut reporter(
-                &mut *self.progress,
-                Phase::Adaptive,
-                round,
-                n,
-                options.tolerance,
-            ),
+            &mut self.reporter.part(base),
         )?;
+        if self.reporter.stopped() {
+            return Ok(None);
+        }
         let samples = &solution.samples;
         let mut changed = vec![false; 2 * solution.maps.len()];
         for k in 0..samples.len() {

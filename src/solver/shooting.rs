@@ -3,8 +3,8 @@
 
 use glam::DVec3;
 
-use super::progress::Phase;
 use super::stats::EnergyLedger;
+use crate::progress::Phase;
 use crate::sampling::{Samples, SurfaceMap};
 
 /// The solver state that shooting changes.
@@ -39,6 +39,8 @@ pub(crate) struct Settings {
     pub lift: f32,
     /// Bytes the solver's large structures (caches, links) may hold.
     pub memory_bytes: usize,
+    /// The whole memory budget (for messages).
+    pub budget: usize,
     /// Compute the receivers' row sums and scales (see `normalise`) before shooting.
     pub normalise: bool,
     /// The hierarchy's error threshold (0: the flat solver).

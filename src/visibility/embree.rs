@@ -264,3 +264,8 @@ impl Visibility for EmbreeScene {
 pub fn headers() -> &'static str {
     sys::HEADERS
 }
+
+/// The major version of the Embree the shim was compiled against ("3" or "4").
+pub fn major() -> &'static str {
+    sys::MAJOR
+}

@@ -16,7 +16,9 @@ use crate::scene::Scene;
 
 pub use bvh::{BvhPreset, BvhScene};
 #[cfg(feature = "embree")]
-pub use embree::{headers as embree_headers, EmbreeMode, EmbreeOptions, EmbreeScene};
+pub use embree::{
+    headers as embree_headers, major as embree_major, EmbreeMode, EmbreeOptions, EmbreeScene,
+};
 
 /// A segment between two points. The backends test it over the parameter interval
 /// [`SEGMENT_T_MIN`, `SEGMENT_T_MAX`] of `a + t (b − a)`: the ends themselves never block.

@@ -167,6 +167,7 @@ pub fn solve_and_render(
             &solution,
             vis.as_ref(),
             &meshlight::RenderOptions::default(),
+            &mut |_| meshlight::Control::Continue,
         )
         .unwrap()
         .0
@@ -228,17 +229,17 @@ pub fn two_rooms() -> Scene {
 /// enough samples on both sides for that to mean something.
 pub fn assert_dark_room_is_dark(s: &meshlight::Solution, label: &str) {
     let (mut dark, mut lit) = (0, 0);
-    for k in 0..s.samples.len() {
-        let x = s.samples.position[k].x;
+    for k in 0..s.samples().len() {
+        let x = s.samples().position()[k].x;
         if x > 2.2 {
             assert_eq!(
-                s.radiosity[k],
+                s.radiosity()[k],
                 glam::DVec3::ZERO,
                 "{label}: sample {k} at {} in the dark room",
-                s.samples.position[k]
+                s.samples().position()[k]
             );
             dark += 1;
-        } else if x < 2.0 && s.radiosity[k].x > 0.0 {
+        } else if x < 2.0 && s.radiosity()[k].x > 0.0 {
             lit += 1;
         }
     }

@@ -9,9 +9,9 @@ mod render;
 mod solve;
 
 use crate::error::{Error, Result};
+use crate::progress::{Callback, Control, Phase, Progress, Reporter};
 use crate::render::Image;
 use crate::scene::Scene;
-use crate::solver::Control;
 use crate::visibility::Visibility;
 
 /// Most rays per side of a pixel when rendering patches.
@@ -50,19 +50,6 @@ impl Default for PatchOptions {
     }
 }
 
-/// How far a patch solve has got.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PatchProgress {
-    /// Patches in the mesh.
-    pub patches: usize,
-    /// Shots so far.
-    pub shots: u64,
-    /// Unshot power / the power there was to shoot.
-    pub unshot_fraction: f64,
-    /// What the shooting aims at.
-    pub tolerance: f64,
-}
-
 /// A rendered patch solution and what it cost.
 #[derive(Clone, Debug)]
 pub struct PatchImage {
@@ -83,18 +70,21 @@ pub struct PatchImage {
 }
 
 /// Meshes, solves and renders the scene's camera view with patches of side
-/// `options.patch_size`; `progress` hears about the shooting now and then and may stop it.
+/// `options.patch_size`. `progress` hears the meshing, the shooting now and then
+/// ([`Phase::Shooting`]: `items` the patches, `shots`, `unshot_fraction`, `tolerance`) and the
+/// rendering. A Stop ends the shooting; the estimate so far is then rendered in full (the
+/// render is short beside the shooting) and [`PatchImage::stopped`] says so.
 pub fn patch_radiosity(
     scene: &Scene,
     vis: &dyn Visibility,
     options: &PatchOptions,
-    progress: &mut dyn FnMut(PatchProgress) -> Control,
+    progress: Callback,
 ) -> Result<PatchImage> {
     crate::parallel::guarded("the patch solver", || {
         let size = options.patch_size;
         if !(size.is_finite() && size > 0.0) {
             return Err(Error::Option {
-                option: "patch-size",
+                option: "patch_size",
                 problem: format!("must be a positive length, not {size}"),
             });
         }
@@ -120,7 +110,7 @@ pub fn patch_radiosity(
         let cell_limit = 16.0 * options.max_patches as f64;
         if cells > cell_limit {
             return Err(Error::Option {
-                option: "patch-size",
+                option: "patch_size",
                 problem: format!(
                     "{size} lays grids of {cells:.0} cells over the surfaces' bounding boxes, more \
                      than the {cell_limit:.0} allowed (16 × the patch limit): choose a larger size"
@@ -130,7 +120,7 @@ pub fn patch_radiosity(
         let estimate = mesh::estimate(scene, size);
         if estimate > options.max_patches as f64 {
             return Err(Error::Option {
-                option: "patch-size",
+                option: "patch_size",
                 problem: format!(
                     "{size} cuts the scene's {:.1} area units into about {estimate:.0} patches, more \
                      than the {} allowed (the solve grows as the square): choose a larger size",
@@ -139,11 +129,13 @@ pub fn patch_radiosity(
                 ),
             });
         }
+        let mut reporter = Reporter::new(progress);
+        reporter.report(Progress::of(Phase::Meshing));
         let t = std::time::Instant::now();
         let mesh = mesh::mesh(scene, size);
         if mesh.patches.len() > options.max_patches {
             return Err(Error::Option {
-                option: "patch-size",
+                option: "patch_size",
                 problem: format!(
                     "{size} cuts the surfaces into {} patches (slivers of cells count too), more \
                      than the {} allowed: choose a larger size",
@@ -175,17 +167,31 @@ pub fn patch_radiosity(
             options.tolerance,
             options.max_shots,
             &mut |shots, unshot_fraction| {
-                progress(PatchProgress {
-                    patches,
+                // The share of the way on a log scale: unshot power falls about geometrically.
+                let fraction =
+                    (unshot_fraction.max(1e-300).ln() / options.tolerance.ln()).clamp(0.0, 1.0);
+                let stop = reporter.report(Progress {
+                    items: patches,
                     shots,
                     unshot_fraction,
                     tolerance: options.tolerance,
-                })
+                    fraction,
+                    ..Progress::of(Phase::Shooting)
+                });
+                if stop {
+                    Control::Stop
+                } else {
+                    Control::Continue
+                }
             },
         )?;
         let solving = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let radiosity: Vec<_> = shooting.state.iter().map(|s| s.radiosity).collect();
+        reporter.report(Progress {
+            items: patches,
+            ..Progress::of(Phase::Rendering)
+        });
         let image = render::render(
             scene,
             &mesh,

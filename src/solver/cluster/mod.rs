@@ -29,11 +29,11 @@ use self::sweep::{shooters, Shooter, Sources};
 use self::tree::{Ref, Tree};
 use super::normalise::row_scale;
 use super::pipeline::with_pool;
-use super::progress::Control;
 use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
 use crate::error::Result;
 use crate::parallel::for_chunks;
+use crate::progress::Control;
 use crate::visibility::Visibility;
 
 /// Shooters darker than this fraction of the mean radiosity are weighed as this bright in the
@@ -155,17 +155,16 @@ pub(crate) fn shoot(
             stats.queries += first.queries + second.queries;
             held += first.bytes() + second.bytes();
             if held > settings.memory_bytes {
-                return Err(crate::Error::Option {
-                    option: "memory_budget",
-                    problem: format!(
-                        "the cluster links outgrew what the samples leave of the memory budget \
-                         ({} after {} of {} groups' pairs; raise --memory-budget or \
-                         --cluster-threshold)",
-                        super::human_bytes(settings.memory_bytes as f64),
+                return Err(crate::budget::exceeded(
+                    settings.budget,
+                    format!(
+                        "the cluster links outgrew what the samples leave of the budget ({} after \
+                         {} of {} groups' pairs): raise the budget or the cluster threshold",
+                        crate::budget::human_bytes(settings.memory_bytes as f64),
                         job + 1,
                         total
                     ),
-                });
+                ));
             }
             for (group, links) in [(x, first), (y, second)] {
                 if !(links.leaf.is_empty() && links.cluster.is_empty()) {

@@ -64,28 +64,23 @@ pub fn run(
     options: &LuxOptions,
     dir: &Path,
 ) -> Result<()> {
-    if scene.grids.is_empty() {
+    if scene.grids().is_empty() {
         anyhow::bail!(
-            "{}: the scene has no [[grid]] to measure (scene-format.md, \"Grids\")",
-            scene.path.display()
+            "{}: the scene has no [[grid]] to measure (docs/scene-format.md, \"Grids\")",
+            scene.path().display()
         );
     }
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    let unit = scene.units.irradiance();
-    for grid in &scene.grids {
+    let unit = scene.units().irradiance();
+    for grid in scene.grids() {
         let started = Instant::now();
         let points = grid.points();
-        eprint!("grid '{}': {} points", grid.name, points.len());
-        let mut last = -1i32;
-        let e = illuminance(scene, solution, vis, grid, options, &mut |f| {
-            let pct = (100.0 * f) as i32;
-            if pct / 10 > last / 10 {
-                last = pct;
-                eprint!("\rgrid '{}': {} points, {pct}%   ", grid.name, points.len());
-            }
+        let what = format!("grid '{}', {} points", grid.name(), points.len());
+        let e = crate::progress::with_progress(&what, |progress| {
+            illuminance(scene, solution, vis, grid, options, progress)
         })?;
-        eprintln!();
         let values: Vec<f64> = e
+            .values
             .iter()
             .map(|v| f64::from(luminance(v.as_vec3())))
             .collect();
@@ -111,7 +106,7 @@ pub fn run(
         let s = Summary::of(&open);
         let line = format!(
             "grid '{}': {} points{}, Emin {:.4} {unit}, Eavg {:.4} {unit}, Emax {:.4} {unit}, U0 = Emin/Eavg {:.3}, Emin/Emax {:.3}; {:.2} s",
-            grid.name,
+            grid.name(),
             values.len(),
             if left_out > 0 {
                 format!(" ({left_out} inside solids left out)")
@@ -128,11 +123,11 @@ pub fn run(
         let png = dir.join(format!("{stem}.png"));
         super::plot::plan_png(
             &png,
-            (grid.n_u, grid.n_v),
+            grid.counts_uv(),
             &values,
             (0.0, s.max),
             unit,
-            &format!("{} ({unit})", grid.name),
+            &format!("{} ({unit})", grid.name()),
             &[
                 format!("Emin {:.4}", s.min),
                 format!("Eavg {:.4}", s.avg),

@@ -37,8 +37,8 @@ pub fn run(
     };
     println!(
         "scene {}: {} triangles; {} thread(s), {} rounds, backend {}; hierarchy threshold {threshold}",
-        scene.path.display(),
-        scene.triangles.len(),
+        scene.path().display(),
+        scene.triangles().len(),
         options.threads,
         options.rounds,
         vis.name()
@@ -110,7 +110,7 @@ pub fn run(
 
 fn measure(flat: bool, epsilon: f32, s: &Solution, total: f64, peak: Option<u64>) -> Run {
     let mut seconds = [0.0; 6];
-    for r in &s.rounds {
+    for r in s.rounds() {
         let p = &r.seconds;
         for (x, y) in seconds
             .iter_mut()
@@ -123,9 +123,9 @@ fn measure(flat: bool, epsilon: f32, s: &Solution, total: f64, peak: Option<u64>
     Run {
         flat,
         epsilon,
-        samples: s.samples.len(),
-        links: s.rounds.iter().map(|r| r.shooting.links).sum(),
-        queries: s.rounds.iter().map(|r| r.shooting.queries).sum(),
+        samples: s.samples().len(),
+        links: s.rounds().iter().map(|r| r.shooting.links).sum(),
+        queries: s.rounds().iter().map(|r| r.shooting.queries).sum(),
         seconds,
         peak,
     }
@@ -147,7 +147,7 @@ fn row(r: &Run) -> String {
         s,
         " {:>10}",
         r.peak
-            .map_or("-".into(), |b| meshlight::solver::human_bytes(b as f64))
+            .map_or("-".into(), |b| meshlight::budget::human_bytes(b as f64))
     );
     s
 }

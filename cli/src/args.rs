@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 use meshlight::visibility::BvhPreset;
-use meshlight::{Backend, Options, Scene};
+use meshlight::{Backend, Options};
 
 /// Meshless diffuse inter-reflection for rooms, galleries and other interiors.
 #[derive(Parser)]
@@ -21,9 +21,6 @@ pub struct Args {
     #[arg(long, global = true)]
     pub max_reflectance: Option<f32>,
 }
-
-/// How scenes are read, from the command line (set once, before any scene is loaded).
-pub static LOADING: std::sync::OnceLock<meshlight::scene::LoadOptions> = std::sync::OnceLock::new();
 
 /// Solver settings shared by `render` and `samples`.
 #[derive(clap::Args)]
@@ -124,49 +121,137 @@ pub enum Method {
     Patches,
 }
 
+/// `render`'s arguments.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Output image (.exr); the PNG gets the same name with .png.
+    #[arg(short, long, default_value = "out.exr")]
+    pub output: PathBuf,
+    /// Rays per side on pixels that straddle an edge (1 = one ray per pixel).
+    #[arg(long, default_value_t = 4)]
+    pub supersample: u32,
+    /// Meshless: shadow rays per area light traced at each camera hit for its direct light
+    /// (one per point light); 0 interpolates the direct light from the samples, as the paper.
+    #[arg(long, default_value_t = 16,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
+    pub direct_rays: u32,
+    /// How to compute the image: meshless (the solver), or pathtrace (the independent
+    /// reference: unbiased Monte Carlo path tracing).
+    #[arg(long, default_value = "meshless")]
+    pub method: Method,
+    /// Path tracing: samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Path tracing: stop after this many seconds (with fewer samples per pixel).
+    #[arg(long)]
+    pub time: Option<f64>,
+    /// Patches: the side of the square patches (default: the solver's ε).
+    #[arg(long)]
+    pub patch_size: Option<f32>,
+    /// Write the PNG as a false-colour picture with a legend in the scene's unit instead of
+    /// a tone-mapped one: the luminance seen, or the illuminance on the surface seen (then
+    /// the EXR holds the illuminance too).
+    #[arg(long, value_enum)]
+    pub false_color: Option<FalseColor>,
+    /// The false colours' range, MIN:MAX (default 0 to the 99th percentile; with --log,
+    /// the 1st to the 99th percentile of the non-zero values).
+    #[arg(long, value_parser = parse_range)]
+    pub range: Option<(f64, f64)>,
+    /// Logarithmic false colours.
+    #[arg(long)]
+    pub log: bool,
+}
+
+/// `sweep`'s arguments.
+#[derive(clap::Args)]
+pub struct SweepArgs {
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// The reference image (.exr), e.g. from `render --method pathtrace` with many samples;
+    /// every run renders at its size.
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
+    /// Keys: preset, epsilon, zeta, alpha, rounds, light-samples, tolerance, max-shots,
+    /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
+    /// supersample, direct-rays, patch-size, spp.
+    #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
+    pub vary: Vec<(String, Vec<String>)>,
+    /// How each run computes its image.
+    #[arg(long, default_value = "meshless")]
+    pub method: Method,
+    /// Rays per side on edge pixels (meshless) or per pixel (patches).
+    #[arg(long, default_value_t = 4)]
+    pub supersample: u32,
+    /// Meshless: shadow rays per area light traced at each camera hit for its direct light;
+    /// 0 interpolates it from the samples.
+    #[arg(long, default_value_t = 16,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
+    pub direct_rays: u32,
+    /// Patches: the side of the square patches (default: the solver's ε).
+    #[arg(long)]
+    pub patch_size: Option<f32>,
+    /// Path tracing runs: samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Output prefix: writes PREFIX.csv and PREFIX.png.
+    #[arg(long, default_value = "sweep")]
+    pub out: PathBuf,
+    /// Leave out the path tracer's curve.
+    #[arg(long)]
+    pub no_pathtrace: bool,
+    /// Measure errors on averages over blocks of N × N pixels (see `compare --block`).
+    #[arg(long, default_value_t = 1)]
+    pub block: u32,
+    /// The path tracer's curve doubles samples per pixel from 2 up to this many, or until a
+    /// render takes longer than --pathtrace-seconds.
+    #[arg(long, default_value_t = 4096)]
+    pub max_spp: u32,
+    /// The path tracer's curve stops after a render longer than this (default: twice the
+    /// slowest run). Its seed differs from --seed, so it never repeats the samples of a
+    /// reference traced with --seed.
+    #[arg(long)]
+    pub pathtrace_seconds: Option<f64>,
+}
+
+/// `bench-vis`'s arguments.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// Occlusion queries: segments between random points of facing surfaces.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub queries: usize,
+    /// Closest-hit queries: camera rays.
+    #[arg(long, default_value_t = 100_000)]
+    pub rays: usize,
+    /// Thread counts to measure, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1, 2])]
+    pub threads: Vec<usize>,
+    /// Backends to measure, comma-separated (embree, bvh); default: all in this build.
+    #[arg(long, value_delimiter = ',')]
+    pub backend: Vec<Backend>,
+    /// obvhs presets to measure for `bvh`: fast, medium, very-slow, thorough, thorough-wide,
+    /// or all.
+    #[arg(long, value_delimiter = ',', default_value = "thorough-wide")]
+    pub bvh_preset: Vec<String>,
+    /// Queries per call through the backend trait.
+    #[arg(long, default_value_t = 1024)]
+    pub batch: usize,
+    /// Each figure is the best of this many runs.
+    #[arg(long, default_value_t = 3)]
+    pub repeats: usize,
+    /// Seed of the random queries.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
 #[derive(Subcommand)]
 pub enum Command {
     /// Solve a scene and render its camera view: linear OpenEXR plus a tone-mapped PNG beside it.
-    Render {
-        #[command(flatten)]
-        solve: SolveArgs,
-        /// Output image (.exr); the PNG gets the same name with .png.
-        #[arg(short, long, default_value = "out.exr")]
-        output: PathBuf,
-        /// Rays per side on pixels that straddle an edge (1 = one ray per pixel).
-        #[arg(long, default_value_t = 4)]
-        supersample: u32,
-        /// Meshless: shadow rays per area light traced at each camera hit for its direct light
-        /// (one per point light); 0 interpolates the direct light from the samples, as the paper.
-        #[arg(long, default_value_t = 16,
-              value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::light::MAX_LIGHT_SAMPLES)))]
-        direct_rays: u32,
-        /// How to compute the image: meshless (the solver), or pathtrace (the independent
-        /// reference: unbiased Monte Carlo path tracing).
-        #[arg(long, default_value = "meshless")]
-        method: Method,
-        /// Path tracing: samples per pixel.
-        #[arg(long, default_value_t = 64)]
-        spp: u32,
-        /// Path tracing: stop after this many seconds (with fewer samples per pixel).
-        #[arg(long)]
-        time: Option<f64>,
-        /// Patches: the side of the square patches (default: the solver's ε).
-        #[arg(long)]
-        patch_size: Option<f32>,
-        /// Write the PNG as a false-colour picture with a legend in the scene's unit instead of
-        /// a tone-mapped one: the luminance seen, or the illuminance on the surface seen (then
-        /// the EXR holds the illuminance too).
-        #[arg(long, value_enum)]
-        false_color: Option<FalseColor>,
-        /// The false colours' range, MIN:MAX (default 0 to the 99th percentile; with --log,
-        /// the 1st to the 99th percentile of the non-zero values).
-        #[arg(long, value_parser = parse_range)]
-        range: Option<(f64, f64)>,
-        /// Logarithmic false colours.
-        #[arg(long)]
-        log: bool,
-    },
+    Render(RenderArgs),
     /// Compare an image with a reference: mean absolute error / mean (the paper's measure) and more.
     Compare {
         /// The image to judge (.exr).
@@ -188,55 +273,7 @@ pub enum Command {
     },
     /// Run a grid of settings against a reference image: a CSV of time and error per run, and
     /// a plot of error against time with the Pareto front and the path tracer's curve.
-    Sweep {
-        #[command(flatten)]
-        solve: SolveArgs,
-        /// The reference image (.exr), e.g. from `render --method pathtrace` with many samples;
-        /// every run renders at its size.
-        #[arg(long)]
-        reference: PathBuf,
-        /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
-        /// Keys: preset, epsilon, zeta, alpha, rounds, light-samples, tolerance, max-shots,
-        /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
-        /// supersample, direct-rays, patch-size, spp.
-        #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
-        vary: Vec<(String, Vec<String>)>,
-        /// How each run computes its image.
-        #[arg(long, default_value = "meshless")]
-        method: Method,
-        /// Rays per side on edge pixels (meshless) or per pixel (patches).
-        #[arg(long, default_value_t = 4)]
-        supersample: u32,
-        /// Meshless: shadow rays per area light traced at each camera hit for its direct light;
-        /// 0 interpolates it from the samples.
-        #[arg(long, default_value_t = 16,
-              value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::light::MAX_LIGHT_SAMPLES)))]
-        direct_rays: u32,
-        /// Patches: the side of the square patches (default: the solver's ε).
-        #[arg(long)]
-        patch_size: Option<f32>,
-        /// Path tracing runs: samples per pixel.
-        #[arg(long, default_value_t = 64)]
-        spp: u32,
-        /// Output prefix: writes PREFIX.csv and PREFIX.png.
-        #[arg(long, default_value = "sweep")]
-        out: PathBuf,
-        /// Leave out the path tracer's curve.
-        #[arg(long)]
-        no_pathtrace: bool,
-        /// Measure errors on averages over blocks of N × N pixels (see `compare --block`).
-        #[arg(long, default_value_t = 1)]
-        block: u32,
-        /// The path tracer's curve doubles samples per pixel from 2 up to this many, or until a
-        /// render takes longer than --pathtrace-seconds.
-        #[arg(long, default_value_t = 4096)]
-        max_spp: u32,
-        /// The path tracer's curve stops after a render longer than this (default: twice the
-        /// slowest run). Its seed differs from --seed, so it never repeats the samples of a
-        /// reference traced with --seed.
-        #[arg(long)]
-        pathtrace_seconds: Option<f64>,
-    },
+    Sweep(SweepArgs),
     /// Solve a scene and measure the illuminance on its grids ([[grid]]): per grid a CSV of
     /// x,y,z,E, a false-colour plan (PNG) and a line with Emin, Eavg, Emax and the uniformity.
     Lux {
@@ -247,7 +284,7 @@ pub enum Command {
         output: PathBuf,
         /// Shadow rays per area light and grid point.
         #[arg(long, default_value_t = 64,
-              value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::light::MAX_LIGHT_SAMPLES)))]
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
         grid_light_samples: u32,
     },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
@@ -280,35 +317,7 @@ pub enum Command {
         scene: PathBuf,
     },
     /// Measure the visibility backends on a scene (occlusion and closest-hit rates).
-    BenchVis {
-        /// The scene file (TOML).
-        scene: PathBuf,
-        /// Occlusion queries: segments between random points of facing surfaces.
-        #[arg(long, default_value_t = 1_000_000)]
-        queries: usize,
-        /// Closest-hit queries: camera rays.
-        #[arg(long, default_value_t = 100_000)]
-        rays: usize,
-        /// Thread counts to measure, comma-separated.
-        #[arg(long, value_delimiter = ',', default_values_t = [1, 2])]
-        threads: Vec<usize>,
-        /// Backends to measure, comma-separated (embree, bvh); default: all in this build.
-        #[arg(long, value_delimiter = ',')]
-        backend: Vec<Backend>,
-        /// obvhs presets to measure for `bvh`: fast, medium, very-slow, thorough, thorough-wide,
-        /// or all.
-        #[arg(long, value_delimiter = ',', default_value = "thorough-wide")]
-        bvh_preset: Vec<String>,
-        /// Queries per call through the backend trait.
-        #[arg(long, default_value_t = 1024)]
-        batch: usize,
-        /// Each figure is the best of this many runs.
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-        /// Seed of the random queries.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-    },
+    BenchVis(BenchArgs),
 }
 
 /// Parses `--bvh-preset` names.
@@ -328,17 +337,6 @@ pub fn bvh_presets(names: &[String]) -> anyhow::Result<Vec<BvhPreset>> {
         }
     }
     Ok(presets)
-}
-
-/// The scene, and options from a preset, the scene file and the command line, in that order
-/// of precedence.
-pub fn solve_setup(
-    scene: &std::path::Path,
-    epsilon: Option<f32>,
-    args: &Knobs,
-) -> anyhow::Result<(Scene, Options)> {
-    let scene = crate::load(scene)?;
-    Ok((scene, options_from(epsilon, args)?))
 }
 
 /// A size in bytes: a number with an optional K, M or G suffix (binary units).

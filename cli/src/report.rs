@@ -21,17 +21,17 @@ fn rgb(v: DVec3) -> String {
 /// `meshlight info`.
 pub fn info(scene: &Scene) -> String {
     let mut s = String::new();
-    let b = &scene.bounds;
-    let c = &scene.camera;
-    let _ = writeln!(s, "scene         {}", scene.path.display());
-    let _ = writeln!(s, "triangles     {}", scene.triangles.len());
-    let _ = writeln!(s, "surfaces      {}", scene.surfaces.len());
-    let _ = writeln!(s, "materials     {}", scene.materials.len());
+    let b = &scene.bounds();
+    let c = &scene.camera();
+    let _ = writeln!(s, "scene         {}", scene.path().display());
+    let _ = writeln!(s, "triangles     {}", scene.triangles().len());
+    let _ = writeln!(s, "surfaces      {}", scene.surfaces().len());
+    let _ = writeln!(s, "materials     {}", scene.materials().len());
     let _ = writeln!(s, "total area    {:.6}", scene.total_area());
     let _ = writeln!(
         s,
         "two-sided     {}",
-        if scene.two_sided { "yes" } else { "no" }
+        if scene.two_sided() { "yes" } else { "no" }
     );
     let _ = writeln!(
         s,
@@ -44,7 +44,7 @@ pub fn info(scene: &Scene) -> String {
     let area: f64 = 0.0
         + emitters
             .iter()
-            .map(|&(i, _)| scene.surfaces[i as usize].area)
+            .map(|&(i, _)| scene.surfaces()[i as usize].area)
             .sum::<f64>();
     let power: DVec3 = emitters.iter().map(|&(_, p)| p).sum();
     let _ = writeln!(
@@ -56,11 +56,11 @@ pub fn info(scene: &Scene) -> String {
     );
     const LISTED: usize = 10;
     for &(i, p) in emitters.iter().take(LISTED) {
-        let surface = &scene.surfaces[i as usize];
+        let surface = &scene.surfaces()[i as usize];
         let _ = writeln!(
             s,
             "  surface {i} '{}': area {:.6}, normal {}, power {} W",
-            scene.material_of(i).name,
+            scene.materials()[surface.material as usize].name,
             surface.area,
             v3(surface.normal),
             rgb(p)
@@ -69,9 +69,9 @@ pub fn info(scene: &Scene) -> String {
     if emitters.len() > LISTED {
         let _ = writeln!(s, "  ... and {} more", emitters.len() - LISTED);
     }
-    let u = scene.units;
-    let _ = writeln!(s, "point lights  {}", scene.point_lights.len());
-    for l in scene.point_lights.iter().take(LISTED) {
+    let u = scene.units();
+    let _ = writeln!(s, "point lights  {}", scene.point_lights().len());
+    for l in scene.point_lights().iter().take(LISTED) {
         let _ = writeln!(
             s,
             "  at {}: intensity {} {}, power {} {}",
@@ -82,11 +82,11 @@ pub fn info(scene: &Scene) -> String {
             u.flux()
         );
     }
-    if scene.point_lights.len() > LISTED {
-        let _ = writeln!(s, "  ... and {} more", scene.point_lights.len() - LISTED);
+    if scene.point_lights().len() > LISTED {
+        let _ = writeln!(s, "  ... and {} more", scene.point_lights().len() - LISTED);
     }
-    let _ = writeln!(s, "luminaires    {}", scene.luminaires.len());
-    for l in scene.luminaires.iter().take(LISTED) {
+    let _ = writeln!(s, "luminaires    {}", scene.luminaires().len());
+    for l in scene.luminaires().iter().take(LISTED) {
         let flux = l.flux();
         let _ = writeln!(
             s,
@@ -99,8 +99,8 @@ pub fn info(scene: &Scene) -> String {
             u.flux()
         );
     }
-    if scene.luminaires.len() > LISTED {
-        let _ = writeln!(s, "  ... and {} more", scene.luminaires.len() - LISTED);
+    if scene.luminaires().len() > LISTED {
+        let _ = writeln!(s, "  ... and {} more", scene.luminaires().len() - LISTED);
     }
     let _ = writeln!(
         s,
@@ -118,7 +118,7 @@ pub fn info(scene: &Scene) -> String {
         c.width,
         c.height
     );
-    match scene.solver.epsilon {
+    match scene.solver_defaults().epsilon {
         Some(e) => {
             let _ = writeln!(s, "solver        epsilon {e} (scene file)");
         }
@@ -155,8 +155,8 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
     let _ = writeln!(
         s,
         "scene {}: {} triangles; {} occlusion segments (facing surface points), {} camera rays",
-        scene.path.display(),
-        scene.triangles.len(),
+        scene.path().display(),
+        scene.triangles().len(),
         r.segments,
         r.rays
     );
@@ -276,7 +276,7 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
 /// The solve's summary: samples per round, shots, queries, unshot fraction, time per phase.
 pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) -> String {
     let mut out = String::new();
-    let source = match s.epsilon_source {
+    let source = match s.epsilon_source() {
         EpsilonSource::Options => "command line",
         EpsilonSource::SceneFile => "scene file",
         EpsilonSource::Automatic => "automatic",
@@ -285,12 +285,12 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
     let _ = writeln!(
         out,
         "scene {}: {} triangles, {} surfaces; backend {}, {} thread(s); ε {} ({source}), α {}, ζ {}, {} light samples",
-        scene.path.display(),
-        scene.triangles.len(),
-        scene.surfaces.len(),
+        scene.path().display(),
+        scene.triangles().len(),
+        scene.surfaces().len(),
         backend,
         o.threads,
-        s.epsilon,
+        s.epsilon(),
         o.alpha,
         o.zeta,
         o.light_samples
@@ -314,7 +314,7 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         "links s",
         "shoot s"
     );
-    for r in &s.rounds {
+    for r in s.rounds() {
         let stop = match r.shooting.stop {
             StopReason::Converged => "converged",
             StopReason::ShotLimit => "shot limit",
@@ -350,8 +350,18 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
             "warning: the solve diverged: its unshot power grew; the image is not to be trusted"
         );
     }
-    let bytes: u64 = s.rounds.iter().map(|r| r.shooting.bytes).max().unwrap_or(0);
-    let samples_bytes: u64 = s.rounds.iter().map(|r| r.solution_bytes).max().unwrap_or(0);
+    let bytes: u64 = s
+        .rounds()
+        .iter()
+        .map(|r| r.shooting.bytes)
+        .max()
+        .unwrap_or(0);
+    let samples_bytes: u64 = s
+        .rounds()
+        .iter()
+        .map(|r| r.solution_bytes)
+        .max()
+        .unwrap_or(0);
     let _ = writeln!(
         out,
         "solver: {}; samples held at most {}, links and caches {}, of a {} budget",
@@ -360,14 +370,14 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         } else {
             "flat (every sample to every sample)".into()
         },
-        meshlight::solver::human_bytes(samples_bytes as f64),
-        meshlight::solver::human_bytes(bytes as f64),
-        meshlight::solver::human_bytes(o.memory_budget as f64),
+        meshlight::budget::human_bytes(samples_bytes as f64),
+        meshlight::budget::human_bytes(bytes as f64),
+        meshlight::budget::human_bytes(o.memory_budget as f64),
     );
-    let emitted = s.ledger.emitted.element_sum();
+    let emitted = s.ledger().emitted.element_sum();
     // Adaptive rounds start new samples from interpolated light, which the ledger does not
     // follow: only a single solve's account adds up.
-    if emitted > 0.0 && s.rounds.len() == 1 {
+    if emitted > 0.0 && s.rounds().len() == 1 {
         // Where the light went: a closed scene's "left" is what the lights that reflect
         // nothing took, plus what the transfer lost; an open one's adds its openings.
         let share = |p: f64| 100.0 * p / emitted;
@@ -376,7 +386,7 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
             "energy: of the emitted power, {:.2}% absorbed by the surfaces, {:.2}% left them \
              (openings, lights that reflect nothing, transfer losses), {:.2}% unshot",
             share(s.absorbed(scene).element_sum()),
-            share(s.ledger.escaped.element_sum()),
+            share(s.ledger().escaped.element_sum()),
             share(s.unshot_power().element_sum())
         );
     }
@@ -384,7 +394,7 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         let _ = writeln!(
             out,
             "warning: the last solve stopped at its shot limit with {:.2e} of the emitted power unshot",
-            s.rounds.last().map_or(0.0, |r| r.shooting.unshot_fraction)
+            s.rounds().last().map_or(0.0, |r| r.shooting.unshot_fraction)
         );
     }
     out

@@ -267,7 +267,7 @@ fn build(
             let options = meshlight::visibility::EmbreeOptions::default();
             let detail = format!(
                 "embree {} {}{}",
-                meshlight_embree_sys::MAJOR,
+                meshlight::visibility::embree_major(),
                 options.occlusion_mode.name(),
                 if options.robust { " robust" } else { "" }
             );

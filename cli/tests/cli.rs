@@ -5,9 +5,15 @@ use std::process::{Command, Output};
 fn meshlight(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_meshlight"))
         .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        // The workspace root, where the shipped scenes are.
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
         .output()
         .expect("run meshlight")
+}
+
+/// A path from the workspace root, where the shipped scenes are.
+fn root(path: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -185,9 +191,9 @@ fn samples_writes_a_ply_point_cloud() {
 #[test]
 fn no_epsilon_means_an_automatic_one_that_is_announced() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::copy("scenes/box/box.obj", dir.path().join("box.obj")).unwrap();
-    std::fs::copy("scenes/box/box.mtl", dir.path().join("box.mtl")).unwrap();
-    let toml = std::fs::read_to_string("scenes/box/scene.toml")
+    std::fs::copy(root("scenes/box/box.obj"), dir.path().join("box.obj")).unwrap();
+    std::fs::copy(root("scenes/box/box.mtl"), dir.path().join("box.mtl")).unwrap();
+    let toml = std::fs::read_to_string(root("scenes/box/scene.toml"))
         .unwrap()
         .replace("[solver]\nepsilon = 0.1\n", "");
     std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
@@ -281,9 +287,13 @@ fn compare_refuses_images_of_different_sizes() {
 fn sweep_writes_a_row_per_setting_and_a_plot() {
     let dir = tempfile::tempdir().unwrap();
     // A 16×16 path-traced reference of the furnace box: every run renders at its size.
-    let mut scene = meshlight::Scene::load("scenes/box/scene.toml").unwrap();
-    scene.camera.width = 16;
-    scene.camera.height = 16;
+    let mut scene = meshlight::Scene::load(root("scenes/box/scene.toml")).unwrap();
+    let camera = meshlight::scene::Camera {
+        width: 16,
+        height: 16,
+        ..scene.camera().clone()
+    };
+    scene.set_camera(camera).unwrap();
     let vis = meshlight::Backend::Bvh.build(&scene).unwrap();
     let traced = meshlight::reference::path_trace(
         &scene,
@@ -292,7 +302,7 @@ fn sweep_writes_a_row_per_setting_and_a_plot() {
             spp: 1024,
             ..Default::default()
         },
-        &mut |_| {},
+        &mut |_| meshlight::Control::Continue,
     )
     .unwrap();
     let reference = dir.path().join("ref.exr");
@@ -385,9 +395,9 @@ fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("scene.toml");
     for f in ["box.obj", "box.mtl"] {
-        std::fs::copy(format!("scenes/box/{f}"), dir.path().join(f)).unwrap();
+        std::fs::copy(root(&format!("scenes/box/{f}")), dir.path().join(f)).unwrap();
     }
-    let toml = std::fs::read_to_string("scenes/box/scene.toml").unwrap()
+    let toml = std::fs::read_to_string(root("scenes/box/scene.toml")).unwrap()
         + "\n[[grid]]\nname = \"mid plane\"\norigin = [0.2, 0.5, 0.2]\nu = [0.6, 0, 0]\nv = [0, 0, 0.4]\nspacing = 0.2\n";
     std::fs::write(&scene, toml).unwrap();
     let out_dir = dir.path().join("lux");

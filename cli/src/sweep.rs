@@ -73,6 +73,26 @@ pub struct Sweep {
     pub pathtrace_seconds: Option<f64>,
 }
 
+impl From<crate::SweepArgs> for Sweep {
+    fn from(a: crate::SweepArgs) -> Sweep {
+        Sweep {
+            vary: a.vary,
+            method: a.method,
+            epsilon: a.solve.epsilon,
+            knobs: a.solve.knobs,
+            supersample: a.supersample,
+            direct_rays: a.direct_rays,
+            patch_size: a.patch_size,
+            spp: a.spp,
+            out: a.out,
+            pathtrace_curve: !a.no_pathtrace,
+            block: a.block,
+            max_spp: a.max_spp,
+            pathtrace_seconds: a.pathtrace_seconds,
+        }
+    }
+}
+
 /// Parses `key=v1,v2,...`.
 pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String> {
     let (key, values) = s
@@ -200,10 +220,13 @@ struct Row {
 /// Runs the sweep, printing a line per run, and writes PREFIX.csv and PREFIX.png.
 pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
     let mut scene = scene.clone();
-    scene.camera.width = reference.width;
-    scene.camera.height = reference.height;
-    if let Some(problem) = scene.camera.problem() {
-        bail!("the reference's size does not make a camera: {problem}");
+    let camera = meshlight::scene::Camera {
+        width: reference.width,
+        height: reference.height,
+        ..scene.camera().clone()
+    };
+    if let Err(e) = scene.set_camera(camera) {
+        bail!("the reference's size does not make a camera: {e}");
     }
     // Check every setting before the first run.
     if sweep.block != 1 {
@@ -244,7 +267,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
     println!(
         "sweep of {} on {} at {}x{}: {} run(s) of {}{}",
         keys.join(" × "),
-        scene.path.display(),
+        scene.path().display(),
         reference.width,
         reference.height,
         runs.len(),
@@ -387,7 +410,7 @@ fn measure(
     let image = match method {
         Method::Meshless => {
             let solution = super::solve_with_progress(scene, vis, options)?;
-            for r in &solution.rounds {
+            for r in solution.rounds() {
                 let s = r.seconds;
                 for (acc, v) in row
                     .seconds
@@ -399,19 +422,22 @@ fn measure(
                 row.shots += r.shooting.shots;
                 row.queries += r.shooting.queries + r.direct_queries;
             }
-            row.samples = solution.samples.len();
+            row.samples = solution.samples().len();
             let t = Instant::now();
-            let (image, _) = meshlight::render(
-                scene,
-                &solution,
-                vis,
-                &meshlight::RenderOptions {
-                    threads: options.threads,
-                    supersample: extra.supersample,
-                    direct: meshlight::Direct::from_rays(extra.direct_rays),
-                    ..meshlight::RenderOptions::default()
-                },
-            )?;
+            let (image, _) = crate::progress::with_progress("render", |progress| {
+                meshlight::render(
+                    scene,
+                    &solution,
+                    vis,
+                    &meshlight::RenderOptions {
+                        threads: options.threads,
+                        supersample: extra.supersample,
+                        direct: meshlight::Direct::from_rays(extra.direct_rays),
+                        ..meshlight::RenderOptions::default()
+                    },
+                    progress,
+                )
+            })?;
             row.seconds[5] = t.elapsed().as_secs_f64();
             image
         }
@@ -536,10 +562,14 @@ fn plot(path: &Path, scene: &Scene, method: Method, rows: &[Row], curve: &[Row])
             colour: RGBColor(178, 24, 43),
         });
     }
-    let name = scene.path.parent().and_then(|p| p.file_name()).map_or_else(
-        || scene.path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
+    let name = scene
+        .path()
+        .parent()
+        .and_then(|p| p.file_name())
+        .map_or_else(
+            || scene.path().display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
     error_time_png(path, &format!("{name}: error against time"), &series)
 }
 

@@ -1,0 +1,292 @@
+//! The `meshlight` command: parses arguments, calls the library, reports. Nothing else.
+
+mod args;
+mod bench;
+mod errors;
+mod lux;
+mod memory;
+mod plot;
+mod progress;
+mod reference;
+mod report;
+mod scale;
+mod sweep;
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use args::*;
+use bench::BenchOptions;
+use clap::Parser;
+use meshlight::scene::LoadOptions;
+use meshlight::{Backend, Image, Scene};
+use progress::solve_with_progress;
+use report::*;
+
+fn main() -> ExitCode {
+    // Like other Unix tools, end quietly when the reader of our output goes away
+    // (`meshlight compare a b | head -1`) instead of panicking on the failed write.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of one signal before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+    let args = Args::parse();
+    let loading = LoadOptions {
+        max_reflectance: args.max_reflectance,
+        strict: args.strict,
+    };
+    match run(args.command, &loading) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("meshlight: error: {}", errors::explain(&e));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
+    match command {
+        Command::Render(render) => render_command(render, loading),
+        Command::Compare {
+            image,
+            reference,
+            diff,
+            diff_range,
+            block,
+        } => compare(&image, &reference, diff.as_deref(), diff_range, block),
+        Command::Sweep(sweep) => {
+            let scene = load(&sweep.solve.scene, loading)?;
+            let reference = Image::read_exr(&sweep.reference)?;
+            sweep::run(&scene, &reference, &sweep::Sweep::from(sweep))
+        }
+        Command::Lux {
+            solve,
+            output,
+            grid_light_samples,
+        } => {
+            let (scene, options) = solve_setup(&solve, loading)?;
+            let vis = backend_from(&solve.knobs).build(&scene)?;
+            let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+            print!("{}", solve_summary(&scene, &solution, &options, vis.name()));
+            let lux = meshlight::lux::LuxOptions {
+                light_samples: grid_light_samples.max(1),
+                seed: options.seed,
+                threads: options.threads,
+            };
+            lux::run(&scene, &solution, vis.as_ref(), &lux, &output)
+        }
+        Command::Samples { solve, output } => samples(&solve, &output, loading),
+        Command::Scale {
+            scene,
+            epsilon,
+            flat_limit,
+            knobs,
+        } => {
+            let scene = load(&scene, loading)?;
+            let options = options_from(None, &knobs)?;
+            let vis = backend_from(&knobs).build(&scene)?;
+            scale::run(&scene, vis.as_ref(), &options, &epsilon, flat_limit)
+        }
+        Command::Info { scene } => {
+            print!("{}", info(&load(&scene, loading)?));
+            Ok(())
+        }
+        Command::BenchVis(bench) => bench_vis(bench, loading),
+    }
+}
+
+/// `render`: solve (or trace, or patch) and write the image, its PNG and a summary.
+fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
+    let started = std::time::Instant::now();
+    if r.method != Method::Meshless && r.false_color.is_some() {
+        anyhow::bail!("--false-color works with --method meshless only");
+    }
+    let (scene, options) = solve_setup(&r.solve, loading)?;
+    let vis = backend_from(&r.solve.knobs).build(&scene)?;
+    // The image and what to say about how it was made, by each method.
+    let (image, summary) = match r.method {
+        Method::Pathtrace => {
+            let path_options = path_options(&r, &options);
+            let traced = reference::path_trace_with_progress(&scene, vis.as_ref(), &path_options)?;
+            let summary =
+                reference::path_summary(&scene, &traced, &path_options, &options, vis.name());
+            (traced.image, summary)
+        }
+        Method::Patches => {
+            let patch_options = patch_options(&scene, &r, &options)?;
+            let solved = reference::patches_with_progress(&scene, vis.as_ref(), &patch_options)?;
+            let summary =
+                reference::patch_summary(&scene, &solved, &patch_options, &options, vis.name());
+            (solved.image, summary)
+        }
+        Method::Meshless => {
+            let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+            let render_options = meshlight::RenderOptions {
+                threads: options.threads,
+                supersample: r.supersample,
+                direct: meshlight::Direct::from_rays(r.direct_rays),
+                quantity: match r.false_color {
+                    Some(FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
+                    _ => meshlight::Quantity::Radiance,
+                },
+            };
+            let t = std::time::Instant::now();
+            let (image, stats) = progress::with_progress("render", |progress| {
+                meshlight::render(&scene, &solution, vis.as_ref(), &render_options, progress)
+            })?;
+            let summary = solve_summary(&scene, &solution, &options, vis.name())
+                + &render_summary(&image, &stats, t.elapsed().as_secs_f64());
+            (image, summary)
+        }
+    };
+    image.write_exr(&r.output)?;
+    let png = r.output.with_extension("png");
+    match r.false_color {
+        None => image.write_png(&png, image.auto_exposure())?,
+        Some(kind) => false_colour_render(&image, &png, kind, r.range, r.log, scene.units())?,
+    }
+    print!("{summary}");
+    println!(
+        "total {:.2} s{}; wrote {} and {}",
+        started.elapsed().as_secs_f64(),
+        memory::peak_bytes().map_or(String::new(), |b| format!(
+            ", peak memory {}",
+            meshlight::budget::human_bytes(b as f64)
+        )),
+        r.output.display(),
+        png.display()
+    );
+    Ok(())
+}
+
+/// The path tracer's settings from `render`'s arguments.
+fn path_options(r: &RenderArgs, options: &meshlight::Options) -> meshlight::reference::PathOptions {
+    meshlight::reference::PathOptions {
+        spp: r.spp,
+        seconds: r.time,
+        seed: options.seed,
+        threads: options.threads,
+        ..Default::default()
+    }
+}
+
+/// The patch baseline's settings from `render`'s arguments (patch size: the solver's ε unless
+/// given).
+fn patch_options(
+    scene: &Scene,
+    r: &RenderArgs,
+    options: &meshlight::Options,
+) -> anyhow::Result<meshlight::reference::PatchOptions> {
+    Ok(meshlight::reference::PatchOptions {
+        patch_size: match r.patch_size {
+            Some(h) => h,
+            None => meshlight::solver::choose_epsilon(scene, options)?.0,
+        },
+        supersample: r.supersample.max(1),
+        tolerance: options.tolerance,
+        max_shots: options.max_shots.unwrap_or(u64::MAX),
+        seed: options.seed,
+        threads: options.threads,
+        ..Default::default()
+    })
+}
+
+/// `compare`: the error measures of an image against a reference, and a picture of the error.
+fn compare(
+    image: &Path,
+    reference: &Path,
+    diff: Option<&Path>,
+    diff_range: Option<f64>,
+    block: u32,
+) -> anyhow::Result<()> {
+    let a = Image::read_exr(image)?;
+    let b = Image::read_exr(reference)?;
+    let e = meshlight::metrics::compare_blocks(&a, &b, block)?;
+    println!("MAE/mean {:.5}", e.mae_over_mean);
+    println!("bias {:+.5} (mean difference / reference mean)", e.bias);
+    println!("RMSE/mean {:.5}", e.rmse_over_mean);
+    println!("p99 error/mean {:.5}", e.p99_over_mean);
+    println!(
+        "mean {:.5} {:.5} {:.5} vs reference {:.5} {:.5} {:.5}",
+        e.mean[0],
+        e.mean[1],
+        e.mean[2],
+        e.reference_mean[0],
+        e.reference_mean[1],
+        e.reference_mean[2]
+    );
+    if let Some(path) = diff {
+        let range = plot::write_error_picture(&a, &b, &e, diff_range, path)?;
+        println!(
+            "wrote {} (colours saturate at ±{:.3}% of the reference mean)",
+            path.display(),
+            100.0 * range
+        );
+    }
+    Ok(())
+}
+
+/// `samples`: solve and write the samples as PLY, coloured by radiosity.
+fn samples(solve: &SolveArgs, output: &Path, loading: &LoadOptions) -> anyhow::Result<()> {
+    let (scene, options) = solve_setup(solve, loading)?;
+    let vis = backend_from(&solve.knobs).build(&scene)?;
+    let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+    let radiosity = solution.radiosity();
+    let mean = radiosity.iter().map(|b| b.element_sum() / 3.0).sum::<f64>()
+        / radiosity.len().max(1) as f64
+        / std::f64::consts::PI;
+    let exposure = if mean > 0.0 { (0.4 / mean) as f32 } else { 1.0 };
+    meshlight::ply::write_samples(&solution, output, exposure)?;
+    print!("{}", solve_summary(&scene, &solution, &options, vis.name()));
+    println!(
+        "wrote {} ({} samples)",
+        output.display(),
+        solution.samples().len()
+    );
+    Ok(())
+}
+
+/// `bench-vis`: the visibility backends measured on a scene.
+fn bench_vis(b: BenchArgs, loading: &LoadOptions) -> anyhow::Result<()> {
+    let scene = load(&b.scene, loading)?;
+    let options = BenchOptions {
+        segments: b.queries,
+        rays: b.rays,
+        threads: b.threads,
+        backends: if b.backend.is_empty() {
+            Backend::available()
+        } else {
+            b.backend
+        },
+        bvh_presets: bvh_presets(&b.bvh_preset)?,
+        batch: b.batch,
+        repeats: b.repeats,
+        seed: b.seed,
+    };
+    let report = bench::run(&scene, &options, &mut |step| {
+        eprintln!("  {step}...");
+    })?;
+    print!("{}", bench_report(&scene, &report));
+    Ok(())
+}
+
+/// Loads a scene and prints its warnings to stderr.
+fn load(path: &Path, loading: &LoadOptions) -> anyhow::Result<Scene> {
+    let scene = Scene::load_with(&meshlight::scene::Disk, path, loading)?;
+    for warning in scene.warnings() {
+        eprintln!("meshlight: warning: {warning}");
+    }
+    Ok(scene)
+}
+
+/// The scene, and options from a preset, the scene file and the command line, in that order
+/// of precedence.
+fn solve_setup(
+    solve: &SolveArgs,
+    loading: &LoadOptions,
+) -> anyhow::Result<(Scene, meshlight::Options)> {
+    let scene = load(&solve.scene, loading)?;
+    let options = options_from(solve.epsilon, &solve.knobs)?;
+    Ok((scene, options))
+}

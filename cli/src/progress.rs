@@ -1,0 +1,75 @@
+//! The progress line on stderr while the library works: the phase, the share done and the time
+//! it still needs, for every long call through the library's one progress contract.
+
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use meshlight::progress::{Control, Phase, Progress};
+use meshlight::solver::{EpsilonSource, Options};
+use meshlight::{Scene, Solution, Visibility};
+
+/// Runs `call` with a progress line on stderr about `what` ("solve" gives rounds and samples),
+/// cleared when it returns.
+pub fn with_progress<T>(
+    what: &str,
+    call: impl FnOnce(&mut dyn FnMut(&Progress) -> Control) -> T,
+) -> T {
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}").expect("valid template"),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    let result = call(&mut |p: &Progress| {
+        bar.set_message(line(what, p));
+        Control::Continue
+    });
+    bar.finish_and_clear();
+    result
+}
+
+/// Solves with a progress line, saying first where an automatic ε came from.
+pub fn solve_with_progress(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &Options,
+) -> anyhow::Result<Solution> {
+    let (epsilon, source) = meshlight::solver::choose_epsilon(scene, options)?;
+    if source == EpsilonSource::Automatic {
+        eprintln!(
+            "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area (about {} initial samples)",
+            meshlight::solver::AUTO_SAMPLES
+        );
+    }
+    Ok(with_progress("solve", |progress| {
+        meshlight::solve(scene, vis, options, progress)
+    })?)
+}
+
+/// One progress line: what is being done, how far, and the time left.
+fn line(what: &str, p: &Progress) -> String {
+    let done = if p.fraction > 0.0 {
+        format!(", {:.0}%", 100.0 * p.fraction)
+    } else {
+        String::new()
+    };
+    let left = p
+        .remaining
+        .map_or(String::new(), |s| format!(", about {:.0} s left", s.ceil()));
+    let phase = p.phase.describe();
+    let detail = match p.phase {
+        Phase::Shooting => format!(
+            ", {} shots, unshot {:.2e} of emitted (target {:.0e})",
+            p.shots, p.unshot_fraction, p.tolerance
+        ),
+        Phase::Tracing => format!(", {} of {} samples per pixel", p.shots, p.items),
+        _ => String::new(),
+    };
+    if what == "solve" {
+        format!(
+            "round {}: {phase}: {} samples{detail}{done}{left}",
+            p.round, p.items
+        )
+    } else {
+        format!("{what}: {phase}{detail}{done}{left}")
+    }
+}
