@@ -1,4 +1,4 @@
-//! Prints the figures README's "At the extremes" section quotes (scale and light invariance,
+//! Prints the figures `docs/validation.md`'s "At the extremes" quotes (scale and light invariance,
 //! brighter walls, one sample per surface, albedo 0.99): `cargo run --release --example extremes`.
 
 use meshlight::solver::{Control, Options};

@@ -1,4 +1,4 @@
-//! Representative areas (method.md §4, eqs. 4-6): each surface side is cut by a regular grid of
+//! Representative areas (`docs/method.md` §4 and §10, eqs. 4-6): each surface side is cut by a regular grid of
 //! small cells (each cell clipped exactly to the surface's triangles); a cell's area is split
 //! among the samples of the same side within R of its centroid with weights
 //! w(d/R) = exp(−α d/R), normalised (eq. 5), and a sample's area is the sum of its shares
@@ -284,9 +284,9 @@ impl Shares<'_> {
         let split = |c: usize, out: &mut [CellShares]| {
             let mut near = Vec::new();
             out[0].done = true;
-            for id in c * CHUNK..((c + 1) * CHUNK).min(cells.len()) {
+            let ids = c * CHUNK..((c + 1) * CHUNK).min(cells.len());
+            for (id, &(side, a, centroid)) in ids.clone().zip(&cells[ids]) {
                 if layout.old[id].is_none() {
-                    let (side, a, centroid) = cells[id];
                     let map = &self.maps[surface_of(side) as usize];
                     self.of_cell(id as u32, side, map, a, centroid, &mut near, &mut out[0])?;
                 }
@@ -295,8 +295,8 @@ impl Shares<'_> {
         };
         if !for_chunks_reporting(&mut chunks, 1, threads, split, report)? {
             for (c, chunk) in chunks.iter_mut().enumerate().filter(|(_, c)| !c.done) {
-                for id in c * CHUNK..((c + 1) * CHUNK).min(cells.len()) {
-                    let (side, a, centroid) = cells[id];
+                let ids = c * CHUNK..((c + 1) * CHUNK).min(cells.len());
+                for (id, &(side, a, centroid)) in ids.clone().zip(&cells[ids]) {
                     let nearest = self.index.nearest(self.samples, side, centroid);
                     if let (None, Some(k)) = (layout.old[id], nearest) {
                         chunk.shares.push((id as u32, k, a));

@@ -1,4 +1,4 @@
-//! Direct light at points, integrated from the light sources themselves (method.md §5), so that
+//! Direct light at points, integrated from the light sources themselves (`docs/method.md` §11), so that
 //! shadows do not depend on how many samples lie on a light.
 //!
 //! - Point lights: one shadow ray, irradiance I·cosθ/r².

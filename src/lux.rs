@@ -1,4 +1,4 @@
-//! Illuminance at the points of a grid (scene-format.md, "Grids"): a grid floats in the
+//! Illuminance at the points of a grid (`docs/scene-format.md`, "Grids"; `docs/method.md` §19): a grid floats in the
 //! scene, so interpolating a surface's radiosity is not enough. Direct light comes from the
 //! lights themselves with the solver's estimator (point lights and luminaires by a shadow
 //! ray, area lights by Lambert's formula × the visible share of stratified shadow rays);

@@ -1,5 +1,5 @@
 //! How a long call talks to its host while it runs: one report type and one answer for every
-//! entry point ([`solve`](crate::solve), [`render`](crate::render),
+//! entry point ([`solve`](crate::solve), [`render`](crate::render()),
 //! [`lux::illuminance`](crate::lux::illuminance), [`path_trace`](crate::reference::path_trace)
 //! and [`patch_radiosity`](crate::reference::patch_radiosity)).
 //!
@@ -192,7 +192,6 @@ mod tests {
         // The host now says go on; the stop stands.
         assert!(reporter.report(Progress::of(Phase::DirectLight)));
         assert!(reporter.stopped());
-        drop(reporter);
         assert_eq!(heard.len(), 3);
     }
 
@@ -210,7 +209,6 @@ mod tests {
             fraction: 0.25,
             ..Progress::of(Phase::Rendering)
         });
-        drop(reporter);
         let p = last.unwrap();
         // A quarter done in `elapsed`: three times that left.
         let hint = p.remaining.unwrap();

@@ -1,4 +1,4 @@
-//! Grids and the illuminance at their points: counts and positions by the spec's rule, the
+//! Grids and the illuminance at their points: counts and positions by `docs/scene-format.md`'s rule, the
 //! errors it lists, direct light by hand under a downlight, and the gather of inter-reflected
 //! light in the furnace, where every direction brings the same radiance.
 

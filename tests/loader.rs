@@ -103,7 +103,7 @@ fn the_designed_gallery_has_its_luminaires_and_grids() {
     // The downlight was written as I₀ cos³γ for 1,800 lm: Φ = 2π I₀ / 4 (by hand).
     let flux = s.luminaires()[0].flux().y;
     assert!((flux / 1800.0 - 1.0).abs() < 0.005, "{flux} lm");
-    // Grid counts by the spec's rule: 7.8 × 11.7 m at 0.2 · 5^log10(11.7) = 1.1 m → 7 × 11.
+    // Grid counts by `docs/scene-format.md`'s rule: 7.8 × 11.7 m at 0.2 · 5^log10(11.7) = 1.1 m → 7 × 11.
     assert_eq!(s.grids()[0].counts_uv(), (7, 11));
     assert_eq!(s.grids()[1].counts_uv(), (16, 11));
     assert!(s.warnings().is_empty(), "{:?}", s.warnings());

@@ -1,5 +1,5 @@
 //! Luminaires from IES files in a scene: the direct light on a floor equals I(C, γ)·cosθ/r²
-//! worked out by hand from the file and the spec's orientation rules (aimed down, and tilted
+//! worked out by hand from the file and `docs/scene-format.md`'s orientation rules (aimed down, and tilted
 //! with an asymmetric distribution), on both backends; the scene's `units`, and every
 //! malformed luminaire named by file and line.
 
@@ -95,7 +95,7 @@ fn a_tilted_asymmetric_luminaire_follows_its_aim_and_c0() {
         DVec3::new(1.0, -1.0, 0.0).normalize(),
         DVec3::new(1.0, 1.0, 0.0).normalize(),
     );
-    let c90 = (-aim).cross(c0); // the spec: C 90 points along (−aim) × c0
+    let c90 = (-aim).cross(c0); // docs/scene-format.md: C 90 points along (−aim) × c0
     check(&scene, |x| {
         let d = x.as_dvec3() - p;
         let r = d.length();

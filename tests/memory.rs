@@ -38,10 +38,14 @@ fn a_budget_too_small_is_refused_before_allocating_and_names_the_predicted_size(
         held < (budget / 8) as i64,
         "held {held} bytes before refusing"
     );
-    let Error::Option { option, problem } = &e else {
+    let Error::Budget {
+        budget: named,
+        problem,
+    } = &e
+    else {
         panic!("{e}")
     };
-    assert_eq!(*option, "memory_budget");
+    assert_eq!(*named, budget);
     // The prediction named: about 0.7 × area / ε² samples (ε 0.25, `room`: 296.6 m² of
     // reflecting area, 16 reflecting sides) at BYTES_PER_SAMPLE each.
     let area =
@@ -73,7 +77,7 @@ fn a_budget_too_small_is_refused_before_allocating_and_names_the_predicted_size(
 }
 
 #[test]
-fn links_that_outgrow_the_budget_end_the_solve_with_an_error_and_within_it_nothing_changes() {
+fn links_that_outgrow_the_budget_end_the_solve_with_an_error() {
     let room = Scene::load(shipped("room")).unwrap();
     // A threshold this small links nearly every pair of samples: tens of MB of links.
     let greedy = Options {
@@ -83,16 +87,44 @@ fn links_that_outgrow_the_budget_end_the_solve_with_an_error_and_within_it_nothi
         ..Options::default()
     };
     let e = solve(&room, &greedy).unwrap_err();
+    assert!(matches!(e, Error::Budget { .. }), "{e}");
     assert!(e.to_string().contains("cluster links outgrew"), "{e}");
+}
 
-    // The defaults at 64 MiB and at 8 GiB give the same radiosity, bit for bit.
-    let small = Options {
-        memory_budget: 64 << 20,
+#[test]
+fn where_the_budget_binds_the_flat_solver_keeps_fewer_form_factors_and_gives_the_same_light() {
+    // The flat solver keeps each shooter's form factors for its later shots as long as they fit
+    // in what the samples leave of the budget: `room`'s 3,189 samples keep them all in 8 GiB,
+    // and a few hundred shooters' lists in 24 MiB (the samples are predicted at 10 MiB, so
+    // 24 MiB is just above the 20 MiB the prediction needs).
+    let room = Scene::load(shipped("room")).unwrap();
+    let flat = |memory_budget| Options {
+        cluster_threshold: 0.0,
+        rounds: 0,
+        memory_budget,
         ..Options::default()
     };
-    let (a, b) = (
-        solve(&room, &small).unwrap(),
-        solve(&room, &Options::default()).unwrap(),
+    let roomy = solve(&room, &flat(8 << 30)).unwrap();
+    let tight = solve(&room, &flat(24 << 20)).unwrap();
+    let (r, t) = (&roomy.rounds()[0].shooting, &tight.rounds()[0].shooting);
+    assert!(
+        t.bytes < r.bytes / 2,
+        "the budget binds: {} bytes kept in 24 MiB, {} in 8 GiB",
+        t.bytes,
+        r.bytes
     );
-    assert_eq!(a.radiosity(), b.radiosity());
+    assert!(t.bytes <= 24 << 20, "{} bytes kept", t.bytes);
+    assert!(
+        t.cached_shots < r.cached_shots,
+        "shots answered from kept form factors: {} tight, {} roomy",
+        t.cached_shots,
+        r.cached_shots
+    );
+    // What is not kept is computed again, the same way: the same light, bit for bit.
+    assert_eq!(roomy.radiosity(), tight.radiosity());
+    assert_eq!(r.shots, t.shots);
+
+    // Below what the samples are predicted to take, the flat solver refuses too.
+    let e = solve(&room, &flat(16 << 20)).unwrap_err();
+    assert!(matches!(e, Error::Budget { .. }), "{e}");
 }

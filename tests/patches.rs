@@ -14,7 +14,7 @@ fn small(name: &str, size: u32) -> Scene {
     let camera = meshlight::scene::Camera {
         width: size,
         height: size,
-        ..scene.camera().clone()
+        ..*scene.camera()
     };
     scene.set_camera(camera).unwrap();
     scene

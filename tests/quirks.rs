@@ -1,4 +1,4 @@
-//! Real-world OBJ/MTL quirks load as scene-format.md says: white written as Kd 1 (lowered,
+//! Real-world OBJ/MTL quirks load as `docs/scene-format.md` says: white written as Kd 1 (lowered,
 //! or refused with `strict`), several files on one `mtllib` line, a missing MTL file, a UTF-8
 //! byte-order mark, `v` with a w component, negative indices, `vt`/`vn` face forms, tabs and
 //! CRLF line ends, texture options in the MTL. Each file is written here; the expected
@@ -62,7 +62,7 @@ fn close(a: f64, b: f64) -> bool {
 fn white_written_as_one_is_lowered_with_one_warning() {
     let scene = load(OBJ, "newmtl white\nKd 1 1 1\n");
     let kd = scene.materials()[0].kd;
-    // The default the README documents and justifies.
+    // The default `docs/scene-format.md` documents and justifies.
     assert_eq!(kd, Vec3::splat(0.9));
     assert_eq!(DEFAULT_MAX_REFLECTANCE, 0.9);
     assert_eq!(scene.warnings().len(), 1, "{:?}", scene.warnings());

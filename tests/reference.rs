@@ -12,7 +12,10 @@ use meshlight::{Backend, Scene};
 
 fn trace(scene: &Scene, backend: Backend, options: PathOptions) -> PathImage {
     let vis = backend.build(scene).unwrap();
-    path_trace(scene, vis.as_ref(), &options, &mut |_| meshlight::Control::Continue).unwrap()
+    path_trace(scene, vis.as_ref(), &options, &mut |_| {
+        meshlight::Control::Continue
+    })
+    .unwrap()
 }
 
 /// A shipped scene with a smaller image.
@@ -21,7 +24,7 @@ fn small(name: &str, size: u32) -> Scene {
     let camera = meshlight::scene::Camera {
         width: size,
         height: size,
-        ..scene.camera().clone()
+        ..*scene.camera()
     };
     scene.set_camera(camera).unwrap();
     scene

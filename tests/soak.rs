@@ -117,7 +117,7 @@ fn two_hundred_solves_leave_nothing_behind() {
         let camera = meshlight::scene::Camera {
             width: 32,
             height: 24,
-            ..s.camera().clone()
+            ..*s.camera()
         };
         s.set_camera(camera).unwrap();
     }

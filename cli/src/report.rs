@@ -365,10 +365,10 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
     let _ = writeln!(
         out,
         "solver: {}; samples held at most {}, links and caches {}, of a {} budget",
-        if o.cluster_threshold > 0.0 {
-            format!("cluster hierarchy, threshold {}", o.cluster_threshold)
-        } else {
+        if o.flat() {
             "flat (every sample to every sample)".into()
+        } else {
+            format!("cluster hierarchy, threshold {}", o.cluster_threshold)
         },
         meshlight::budget::human_bytes(samples_bytes as f64),
         meshlight::budget::human_bytes(bytes as f64),

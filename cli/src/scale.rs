@@ -30,10 +30,11 @@ pub fn run(
     epsilons: &[f32],
     flat_limit: f64,
 ) -> anyhow::Result<()> {
-    let threshold = if options.cluster_threshold > 0.0 {
-        options.cluster_threshold
-    } else {
+    // The hierarchy's runs at the options' threshold, or the default's if they ask for flat.
+    let threshold = if options.flat() {
         Options::default().cluster_threshold
+    } else {
+        options.cluster_threshold
     };
     println!(
         "scene {}: {} triangles; {} thread(s), {} rounds, backend {}; hierarchy threshold {threshold}",

@@ -223,7 +223,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
     let camera = meshlight::scene::Camera {
         width: reference.width,
         height: reference.height,
-        ..scene.camera().clone()
+        ..*scene.camera()
     };
     if let Err(e) = scene.set_camera(camera) {
         bail!("the reference's size does not make a camera: {e}");

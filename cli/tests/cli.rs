@@ -13,7 +13,9 @@ fn meshlight(args: &[&str]) -> Output {
 
 /// A path from the workspace root, where the shipped scenes are.
 fn root(path: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(path)
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -291,7 +293,7 @@ fn sweep_writes_a_row_per_setting_and_a_plot() {
     let camera = meshlight::scene::Camera {
         width: 16,
         height: 16,
-        ..scene.camera().clone()
+        ..*scene.camera()
     };
     scene.set_camera(camera).unwrap();
     let vis = meshlight::Backend::Bvh.build(&scene).unwrap();

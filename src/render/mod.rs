@@ -1,4 +1,4 @@
-//! Rendering (method.md §7): camera rays through the backend's closest hit. The direct light at
+//! Rendering (`docs/method.md` §7 and §18): camera rays through the backend's closest hit. The direct light at
 //! a hit is traced there with the solver's estimator ([`Direct::Traced`]; the paper
 //! interpolates it too, [`Direct::Interpolated`]); the rest of its radiance is interpolated
 //! from the samples of the same surface side with smooth, normalised, compactly supported

@@ -1,11 +1,11 @@
-//! Adaptive samples (method.md §6, eqs. 7-8): where a sample's radiosity differs from its
+//! Adaptive samples (`docs/method.md` §6 and §17, eqs. 7-8): where a sample's radiosity differs from its
 //! neighbours' by more than ζ, its influence disc is split (D ← D/√m) and new samples are
 //! placed by Poisson-disk with radii interpolated from their neighbours (eq. 8).
 //!
 //! Decisions: the error compares luminances relative to the mean radiosity of all samples, so
 //! ζ means the same whatever the scene's units or light levels. Only samples whose error
 //! exceeds ζ are refined, with m_k the least count that brings e_k n_k/(n_k + m_k) below ζ,
-//! i.e. m_k = ⌊n_k (e_k/ζ − 1)⌋ + 1 (method.md's ⌊n_k e_k/ζ + 1⌋ drops the −n_k and adds
+//! i.e. m_k = ⌊n_k (e_k/ζ − 1)⌋ + 1 (the paper's ⌊n_k e_k/ζ + 1⌋, `docs/method.md` §6, drops the −n_k and adds
 //! more than n_k samples even where e_k barely exceeds ζ); the m_k new samples and the sample
 //! itself share its disc, so D_k ← D_k/√(m_k + 1). Radii never shrink below ε/[`MAX_SPLIT`].
 

@@ -1,4 +1,4 @@
-//! Initial samples (method.md §3, eq. 3): random points on each reflecting surface side with a
+//! Initial samples (`docs/method.md` §3 and §9, eq. 3): random points on each reflecting surface side with a
 //! minimum spacing ε, by dart throwing against a grid of cells ε/√2 wide (each holds at most
 //! one sample), so a check costs a few cells, never O(n²).
 //!

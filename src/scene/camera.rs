@@ -118,7 +118,7 @@ mod tests {
     #[test]
     fn image_right_is_forward_cross_up_and_top_is_up() {
         let c = camera();
-        // Looking along +z with +y up, +x is on the image's left (the spec's convention).
+        // Looking along +z with +y up, +x is on the image's left (`docs/scene-format.md`, "What the image means").
         let left = c.direction(0.0, 50.0);
         assert!(
             (left - Vec3::new(2.0, 0.0, 1.0).normalize()).length() < 1e-6,

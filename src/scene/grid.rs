@@ -1,4 +1,4 @@
-//! Calculation surfaces (scene-format.md, "Grids"): rectangles of points floating in the
+//! Calculation surfaces (`docs/scene-format.md`, "Grids"): rectangles of points floating in the
 //! scene where illuminance is measured, on a small surface facing `normal`.
 
 use glam::Vec3;
@@ -104,7 +104,7 @@ impl Grid {
         (self.n_u, self.n_v)
     }
 
-    /// The default spacing from EN 12464-1 (as the spec gives it): p = 0.2 · 5^log10(d), d the
+    /// The default spacing from EN 12464-1 (`docs/scene-format.md`, "Grids"): p = 0.2 · 5^log10(d), d the
     /// longer edge.
     pub fn default_spacing(u: Vec3, v: Vec3) -> f32 {
         let d = u.length().max(v.length());

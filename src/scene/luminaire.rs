@@ -1,5 +1,5 @@
 //! Lights at points: isotropic point lights, and luminaires whose intensity follows an IES
-//! distribution (scene-format.md, "Luminaires"). Both light a point x by I(direction)·cosθ/r²
+//! distribution (`docs/scene-format.md`, "Luminaires"). Both light a point x by I(direction)·cosθ/r²
 //! through one shadow ray; [`PointSource`] is what every consumer of light sees of either.
 
 use std::sync::Arc;
@@ -47,7 +47,7 @@ impl Luminaire {
     }
 }
 
-/// Luminance of an RGB triple (Rec. 709 weights, as scene-format.md reports one number).
+/// Luminance of an RGB triple (Rec. 709 weights, as `docs/scene-format.md` reports one number).
 pub fn luminance(rgb: Vec3) -> f32 {
     0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
 }

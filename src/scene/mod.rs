@@ -87,7 +87,7 @@ impl PointLight {
     }
 }
 
-/// What a scene's numbers mean (scene-format.md, "Units"). The solver does not care: it
+/// What a scene's numbers mean (`docs/scene-format.md`, "Units"). The solver does not care: it
 /// carries radiance as luminance alike; only the labels of results change.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Units {

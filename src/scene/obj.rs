@@ -3,7 +3,7 @@
 //! The check runs first so that every problem is reported with its file and line (tobj's errors
 //! carry neither) and so that tobj only ever sees statements the scene format uses, in a form it
 //! cannot trip over: vertices as `v x y z`, faces as vertex indices only, `usemtl`, `mtllib`;
-//! in MTL files `newmtl`, `Kd`, `Ke`. Everything else is ignored, as the spec says. tobj then
+//! in MTL files `newmtl`, `Kd`, `Ke`. Everything else is ignored (`docs/scene-format.md`, "Materials"). tobj then
 //! does the fan triangulation, the per-material split and the index bookkeeping.
 
 use std::cell::RefCell;
@@ -16,7 +16,7 @@ use super::validate::{self, MaterialField};
 use super::{Material, Mesh};
 use crate::error::{Error, Result};
 
-/// Reflectance given to faces that name no material (scene-format.md).
+/// Reflectance given to faces that name no material (`docs/scene-format.md`).
 const DEFAULT_KD: f32 = 0.5;
 
 const OPTIONS: tobj::LoadOptions = tobj::LoadOptions {

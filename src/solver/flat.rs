@@ -1,4 +1,4 @@
-//! The flat solver: progressive radiosity between samples (method.md §5, after Cohen et al.
+//! The flat solver: progressive radiosity between samples (`docs/method.md` §5 and §14, after Cohen et al.
 //! 1988): repeatedly shoot the sample with the largest unshot power to every sample it can
 //! see. Every shooter is linked to every receiver, so a solve is O(N²); the cluster hierarchy
 //! (`cluster`) is what scales. It stays as the exact reference the hierarchy is checked
@@ -18,6 +18,7 @@
 //! instead of asking again, so each pair is queried once, not twice. The bit matrix counts
 //! against the same budget.
 
+use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use crate::error::Result;
@@ -101,7 +102,6 @@ pub(crate) fn shoot(
     }
     let samples = state.samples;
     let n = samples.len();
-    let emitted = state.ledger.emitted.element_sum();
     let mut stats = ShootStats::new();
     let threads = settings.threads.max(1);
     let chunk = n.div_ceil(4 * threads).max(512);
@@ -139,138 +139,192 @@ pub(crate) fn shoot(
             }
             Ok((list.into_boxed_slice(), queries))
         };
-        let delivered_by = |list: &[(u32, f32)]| -> f64 {
-            list.iter()
-                .map(|&(i, f)| f64::from(f) * samples.area[i as usize])
-                .sum()
+        let memo_held = if memo.is_some() { memo_bytes } else { 0 };
+        let mut cache = Cache {
+            lists: vec![None; n],
+            left: settings.memory_bytes.saturating_sub(memo_held),
+            held: memo_held,
         };
-
-        // Per shooter: its visible receivers with (row-scaled) form factors, and Σ F·S.
-        let mut cache: Vec<Option<Kept>> = vec![None; n];
-        let mut cache_left =
-            settings
-                .memory_bytes
-                .saturating_sub(if memo.is_some() { memo_bytes } else { 0 });
-        let mut held = memo.map_or(0, |_| memo_bytes);
-
-        if settings.normalise {
-            // Every receiver's row sum Σⱼ Fᵢⱼ, from every shooter's list.
-            let mut sums = vec![0.0f64; n];
-            for (j, slot) in cache.iter_mut().enumerate() {
-                if j % 256 == 0 && report(Tick::linking(j as f64 / n as f64)) == Control::Stop {
-                    stats.stop = StopReason::Stopped;
-                    return Ok(stats);
-                }
-                let (list, queries) = compute(j)?;
-                stats.queries += queries;
-                for &(i, f) in list.iter() {
-                    sums[i as usize] += f64::from(f);
-                }
-                let bytes = std::mem::size_of_val(&*list);
-                if bytes <= cache_left {
-                    cache_left -= bytes;
-                    held += bytes;
-                    *slot = Some((list, 0.0));
-                }
-            }
-            for (i, scale) in state.row_scale.iter_mut().enumerate() {
-                *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
-            }
-            for kept in cache.iter_mut().flatten() {
-                for (i, f) in kept.0.iter_mut() {
-                    *f *= state.row_scale[*i as usize];
-                }
-                kept.1 = delivered_by(&kept.0);
-            }
+        if settings.normalise
+            && normalise_rows(state, &mut compute, &mut cache, &mut stats, report)?.is_break()
+        {
+            stats.stop = StopReason::Stopped;
+            return Ok(stats);
         }
-
-        let mut first = true;
-        // Unshot power per sample, kept up to date as shots land: the shooter search is then
-        // one pass over a flat array.
-        let mut power: Vec<f64> = (0..n)
-            .map(|k| unshot_power(state.unshot[k], samples.area[k]))
-            .collect();
-        loop {
-            // The shooter: largest unshot power (lowest index on ties).
-            let mut total = 0.0;
-            let mut best = (0.0, usize::MAX);
-            for (k, &p) in power.iter().enumerate() {
-                total += p;
-                if p > best.0 {
-                    best = (p, k);
-                }
-            }
-            stats.unshot_fraction = total / emitted;
-            if stats.unshot_fraction.is_nan() || stats.unshot_fraction >= 1e6 {
-                stats.stop = StopReason::Diverged;
-                break;
-            }
-            if first {
-                stats.initial_unshot_fraction = stats.unshot_fraction;
-                first = false;
-            }
-            if stats.unshot_fraction < settings.tolerance || best.1 == usize::MAX {
-                stats.stop = StopReason::Converged;
-                break;
-            }
-            if stats.shots >= settings.max_shots {
-                stats.stop = StopReason::ShotLimit;
-                break;
-            }
-            if stats.shots % 32 == 0
-                && report(Tick::shooting(
-                    stats.shots,
-                    stats.unshot_fraction,
-                    stats.initial_unshot_fraction,
-                    settings.tolerance,
-                )) == Control::Stop
-            {
-                stats.stop = StopReason::Stopped;
-                break;
-            }
-            let j = best.1;
-
-            // This shooter's form factors, unless they are kept from before.
-            let mut keep = true;
-            if cache[j].is_none() {
-                let (mut list, queries) = compute(j)?;
-                stats.queries += queries;
-                for (i, f) in list.iter_mut() {
-                    *f *= state.row_scale[*i as usize];
-                }
-                let delivered = delivered_by(&list);
-                let bytes = std::mem::size_of_val(&*list);
-                // Over budget, the list serves this shot only.
-                keep = bytes <= cache_left;
-                if keep {
-                    cache_left -= bytes;
-                    held += bytes;
-                }
-                cache[j] = Some((list, delivered));
-            } else {
-                stats.cached_shots += 1;
-            }
-            let (list, delivered) = cache[j].as_ref().expect("filled above");
-
-            let db = state.unshot[j];
-            for &(i, f) in list.iter() {
-                let h = db * f64::from(f);
-                let i = i as usize;
-                state.irradiance[i] += h;
-                state.unshot[i] += state.reflectance[i] * h;
-                power[i] = unshot_power(state.unshot[i], samples.area[i]);
-            }
-            state.ledger.escaped += db * (samples.area[j] - delivered);
-            if !keep {
-                cache[j] = None;
-            }
-            state.unshot[j] = glam::DVec3::ZERO;
-            power[j] = 0.0;
-            stats.shots += 1;
-        }
-        stats.bytes = held as u64;
+        shots(
+            state,
+            &mut compute,
+            &mut cache,
+            settings,
+            &mut stats,
+            report,
+        )?;
+        stats.bytes = cache.held as u64;
         Ok(stats)
     })
+}
+
+/// What a shooter's form factors come from: computed on demand, `(list, queries)`.
+type Compute<'a> = dyn FnMut(usize) -> Result<(List, u64)> + 'a;
+
+/// Shooters' form factors kept for their later shots, within what the budget leaves.
+struct Cache {
+    /// Per shooter: its visible receivers with (row-scaled) form factors, and Σ F·S.
+    lists: Vec<Option<Kept>>,
+    /// Bytes still free for lists.
+    left: usize,
+    /// Bytes held (lists and the visibility memo).
+    held: usize,
+}
+
+impl Cache {
+    /// Whether a list of `bytes` fits; if so it is counted as held.
+    fn take(&mut self, bytes: usize) -> bool {
+        let fits = bytes <= self.left;
+        if fits {
+            self.left -= bytes;
+            self.held += bytes;
+        }
+        fits
+    }
+}
+
+/// Σ F·S over a shooter's receivers: the flux its unit radiosity delivers.
+fn delivered_by(samples: &Samples, list: &[(u32, f32)]) -> f64 {
+    list.iter()
+        .map(|&(i, f)| f64::from(f) * samples.area[i as usize])
+        .sum()
+}
+
+/// Every receiver's row sum Σⱼ Fᵢⱼ from every shooter's list, and the row scales from them
+/// (see `normalise`); the lists that fit are kept, scaled. Whether the host let it finish.
+fn normalise_rows(
+    state: &mut State,
+    compute: &mut Compute,
+    cache: &mut Cache,
+    stats: &mut ShootStats,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<ControlFlow<()>> {
+    let n = state.samples.len();
+    let mut sums = vec![0.0f64; n];
+    for j in 0..n {
+        if j % 256 == 0 && report(Tick::linking(j as f64 / n as f64)) == Control::Stop {
+            return Ok(ControlFlow::Break(()));
+        }
+        let (list, queries) = compute(j)?;
+        stats.queries += queries;
+        for &(i, f) in list.iter() {
+            sums[i as usize] += f64::from(f);
+        }
+        if cache.take(std::mem::size_of_val(&*list)) {
+            cache.lists[j] = Some((list, 0.0));
+        }
+    }
+    for (i, scale) in state.row_scale.iter_mut().enumerate() {
+        *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
+    }
+    for kept in cache.lists.iter_mut().flatten() {
+        for (i, f) in kept.0.iter_mut() {
+            *f *= state.row_scale[*i as usize];
+        }
+        kept.1 = delivered_by(state.samples, &kept.0);
+    }
+    Ok(ControlFlow::Continue(()))
+}
+
+/// Progressive shooting (Southwell): the sample of largest unshot power shoots, until the
+/// unshot power is below the tolerance, the shots run out, or the host stops.
+fn shots(
+    state: &mut State,
+    compute: &mut Compute,
+    cache: &mut Cache,
+    settings: &Settings,
+    stats: &mut ShootStats,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<()> {
+    let samples = state.samples;
+    let n = samples.len();
+    let emitted = state.ledger.emitted.element_sum();
+    let mut first = true;
+    // Unshot power per sample, kept up to date as shots land: the shooter search is then
+    // one pass over a flat array.
+    let mut power: Vec<f64> = (0..n)
+        .map(|k| unshot_power(state.unshot[k], samples.area[k]))
+        .collect();
+    loop {
+        // The shooter: largest unshot power (lowest index on ties).
+        let mut total = 0.0;
+        let mut best = (0.0, usize::MAX);
+        for (k, &p) in power.iter().enumerate() {
+            total += p;
+            if p > best.0 {
+                best = (p, k);
+            }
+        }
+        stats.unshot_fraction = total / emitted;
+        if stats.unshot_fraction.is_nan() || stats.unshot_fraction >= 1e6 {
+            stats.stop = StopReason::Diverged;
+            break;
+        }
+        if first {
+            stats.initial_unshot_fraction = stats.unshot_fraction;
+            first = false;
+        }
+        if stats.unshot_fraction < settings.tolerance || best.1 == usize::MAX {
+            stats.stop = StopReason::Converged;
+            break;
+        }
+        if stats.shots >= settings.max_shots {
+            stats.stop = StopReason::ShotLimit;
+            break;
+        }
+        if stats.shots % 32 == 0
+            && report(Tick::shooting(
+                stats.shots,
+                stats.unshot_fraction,
+                stats.initial_unshot_fraction,
+                settings.tolerance,
+            )) == Control::Stop
+        {
+            stats.stop = StopReason::Stopped;
+            break;
+        }
+        let j = best.1;
+
+        // This shooter's form factors, unless they are kept from before.
+        let mut keep = true;
+        if cache.lists[j].is_none() {
+            let (mut list, queries) = compute(j)?;
+            stats.queries += queries;
+            for (i, f) in list.iter_mut() {
+                *f *= state.row_scale[*i as usize];
+            }
+            let delivered = delivered_by(samples, &list);
+            // Over budget, the list serves this shot only.
+            keep = cache.take(std::mem::size_of_val(&*list));
+            cache.lists[j] = Some((list, delivered));
+        } else {
+            stats.cached_shots += 1;
+        }
+        let (list, delivered) = cache.lists[j].as_ref().expect("filled above");
+
+        let db = state.unshot[j];
+        for &(i, f) in list.iter() {
+            let h = db * f64::from(f);
+            let i = i as usize;
+            state.irradiance[i] += h;
+            state.unshot[i] += state.reflectance[i] * h;
+            power[i] = unshot_power(state.unshot[i], samples.area[i]);
+        }
+        state.ledger.escaped += db * (samples.area[j] - delivered);
+        if !keep {
+            cache.lists[j] = None;
+        }
+        state.unshot[j] = glam::DVec3::ZERO;
+        power[j] = 0.0;
+        stats.shots += 1;
+    }
+    Ok(())
 }
 
 /// Form factors from every sample that sees sample `j` to `j`'s region: (receiver, F).

@@ -1,4 +1,4 @@
-//! Form factors between two samples (method.md eq. 2, with the near field integrated), and the
+//! Form factors between two samples (`docs/method.md` eq. 2 and §12, with the near field integrated), and the
 //! segment whose visibility decides whether they see each other. The flat solver and the
 //! cluster hierarchy's leaf links both use these, so both build the same discrete operator.
 //!

@@ -1,4 +1,4 @@
-//! The meshless solver (method.md §2): initial samples, representative areas, direct light,
+//! The meshless solver (`docs/method.md` §2; rounds in §17): initial samples, representative areas, direct light,
 //! shooting, then adaptive rounds that add samples where light changes and solve again
 //! starting from the previous solution (`warm`).
 //!
@@ -198,7 +198,8 @@ impl Solution {
         for k in 0..n {
             let surface = &scene.surfaces[surface_of(s.side[k]) as usize];
             let off = surface.normal.dot(s.position[k]) - surface.offset;
-            if !(off.abs() <= tolerance) {
+            // NaN positions fail too.
+            if off.is_nan() || off.abs() > tolerance {
                 return fail(format!(
                     "sample {k} at {} does not lie on surface {} (it is {off} off its plane)",
                     s.position[k],
@@ -300,10 +301,10 @@ pub fn solve(
     options: &Options,
     progress: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<Solution> {
-    let method = if options.cluster_threshold > 0.0 {
-        Method::Hierarchy
-    } else {
+    let method = if options.flat() {
         Method::Flat
+    } else {
+        Method::Hierarchy
     };
     crate::parallel::guarded("the solver", || {
         solve_with(scene, vis, options, progress, method)
@@ -540,6 +541,53 @@ mod tests {
                 "sample {k}: flat {a} vs hierarchy {b}"
             );
         }
+    }
+
+    #[test]
+    fn the_samples_are_valid_and_their_check_catches_broken_samples() {
+        let scene = small_room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            rounds: 1,
+            ..Options::default()
+        };
+        let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
+        assert_eq!(s.validate(), Ok(()));
+        assert!(s.samples.round.contains(&1), "adaptive samples too");
+        // Two samples of one side closer than their radii.
+        let mut broken = s.clone();
+        let (a, b) = (0..broken.samples.len())
+            .flat_map(|a| (a + 1..broken.samples.len()).map(move |b| (a, b)))
+            .find(|&(a, b)| broken.samples.side[a] == broken.samples.side[b])
+            .unwrap();
+        broken.samples.uv[b] = broken.samples.uv[a] + glam::Vec2::splat(1e-4);
+        broken.index = SideIndex::new(&broken.samples, &broken.maps, s.epsilon);
+        assert!(broken
+            .validate()
+            .unwrap_err()
+            .contains("closer than their radii"));
+        // A sample's area that is not its shares'.
+        let mut broken = s.clone();
+        broken.samples.area[3] *= 1.01;
+        assert!(broken
+            .validate()
+            .unwrap_err()
+            .contains("is not its shares'"));
+        // Shares that do not tile the cells.
+        let mut broken = s.clone();
+        broken.samples.shares[0].1 *= 2.0;
+        let e = broken.validate().unwrap_err();
+        assert!(
+            e.contains("is not its shares'") || e.contains("shared out"),
+            "{e}"
+        );
+        // A sample the index does not hold.
+        let mut broken = s.clone();
+        broken.index = SideIndex::default();
+        assert!(broken
+            .validate()
+            .unwrap_err()
+            .contains("index does not find"));
     }
 
     #[test]

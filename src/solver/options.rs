@@ -94,6 +94,12 @@ impl Default for Options {
 }
 
 impl Options {
+    /// Whether these options select the flat solver (every sample linked to every sample):
+    /// a cluster threshold of 0. The one place that says what the threshold selects.
+    pub fn flat(&self) -> bool {
+        self.cluster_threshold == 0.0
+    }
+
     /// Fast and rough: no adaptive rounds, few shadow rays, looser convergence.
     pub fn preview() -> Self {
         Options {

@@ -410,9 +410,9 @@ impl Solve<'_> {
             },
             &mut self.reporter.part(base),
         )?;
-        if self.reporter.stopped() {
-            return Ok(None);
-        }
+        // A Stop heard while the errors were measured added nothing; one heard at their last
+        // report may have, and the round that follows then keeps the arrays whole (its
+        // phases are skipped).
         let samples = &solution.samples;
         let mut changed = vec![false; 2 * solution.maps.len()];
         for k in 0..samples.len() {

@@ -23,7 +23,7 @@ use crate::error::Result;
 use crate::scene::Scene;
 
 /// obvhs build settings, fastest build first. Measured on the gallery with
-/// `meshlight bench-vis --bvh-preset all` (README): obvhs's own presets up to `very_slow`
+/// `meshlight bench-vis --bvh-preset all` (`docs/performance.md`, "Visibility backends"): obvhs's own presets up to `very_slow`
 /// leave trees that visit hundreds of nodes per query on scenes of tiled planes; evaluating
 /// every node for reinsertion four times over (`Thorough`) fixes that at about a second of
 /// build per 150k triangles, and the 8-wide CWBVH then traverses fastest.

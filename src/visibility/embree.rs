@@ -78,7 +78,7 @@ pub struct EmbreeOptions {
 }
 
 impl Default for EmbreeOptions {
-    /// Measured with `meshlight bench-vis` on room and gallery (README): streams are the
+    /// Measured with `meshlight bench-vis` on room and gallery (`docs/performance.md`, "Visibility backends"): streams are the
     /// fastest occlusion path in Embree 3 (1.4x packets of 16 on the gallery); Embree 4 has no
     /// streams, and there packets of 8 are next best; packets of 8 lead for closest hits.
     /// Robust traversal keeps light from slipping through edges shared by two triangles.

@@ -59,11 +59,15 @@ pub struct Hit {
     pub triangle: u32,
 }
 
+/// Distance by which query ends are lifted off their surfaces, as a fraction of the scene's
+/// diagonal (see [`lift`]).
+pub const LIFT: f32 = 1e-4;
+
 /// How far every query lifts its ends off their surfaces along the normal, in scene units:
-/// [`workload::LIFT`] × the scene's diagonal, so a point never occludes itself and the answer
+/// [`LIFT`] × the scene's diagonal, so a point never occludes itself and the answer
 /// does not depend on the unit. One value for the solver, the renderer and the references.
 pub fn lift(scene: &Scene) -> f32 {
-    workload::LIFT * scene.bounds.diagonal()
+    LIFT * scene.bounds.diagonal()
 }
 
 /// Answers visibility questions about one scene, a batch at a time, from any number of threads:

@@ -9,10 +9,6 @@ use rand_pcg::Pcg64Mcg;
 use super::{Ray, Segment};
 use crate::scene::Scene;
 
-/// Distance by which segment ends are lifted off their surfaces, as a fraction of the scene's
-/// diagonal: the solver does the same so a sample never occludes itself.
-pub const LIFT: f32 = 1e-4;
-
 /// A point on a reflecting surface side.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
@@ -81,7 +77,7 @@ impl<'a> SurfacePointSampler<'a> {
 }
 
 /// Up to `n` segments between random points of surface sides that face each other, ends lifted
-/// by [`LIFT`] × diagonal along their normals. Fewer come back only if facing pairs are so rare
+/// by [`LIFT`](super::LIFT) × diagonal along their normals. Fewer come back only if facing pairs are so rare
 /// that 100·n draws do not find them.
 pub fn facing_segments(scene: &Scene, n: usize, seed: u64) -> Vec<Segment> {
     let sampler = SurfacePointSampler::new(scene);

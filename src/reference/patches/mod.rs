@@ -81,54 +81,8 @@ pub fn patch_radiosity(
     progress: Callback,
 ) -> Result<PatchImage> {
     crate::parallel::guarded("the patch solver", || {
+        check(scene, options)?;
         let size = options.patch_size;
-        if !(size.is_finite() && size > 0.0) {
-            return Err(Error::Option {
-                option: "patch_size",
-                problem: format!("must be a positive length, not {size}"),
-            });
-        }
-        if !(options.tolerance.is_finite() && options.tolerance > 0.0 && options.tolerance < 1.0) {
-            return Err(Error::Option {
-                option: "tolerance",
-                problem: format!("must lie in (0, 1), not {}", options.tolerance),
-            });
-        }
-        scene.camera.check()?;
-        if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
-            return Err(Error::Option {
-                option: "supersample",
-                problem: format!(
-                    "{} rays per side of a pixel: it must lie in 1..={MAX_SUPERSAMPLE}",
-                    options.supersample
-                ),
-            });
-        }
-        // The grids span each surface's bounding box in its plane: a thin diagonal strip or a
-        // ring holds far more cells than its area says. Bound them before allocating.
-        let cells = mesh::grid_cells(scene, size);
-        let cell_limit = 16.0 * options.max_patches as f64;
-        if cells > cell_limit {
-            return Err(Error::Option {
-                option: "patch_size",
-                problem: format!(
-                    "{size} lays grids of {cells:.0} cells over the surfaces' bounding boxes, more \
-                     than the {cell_limit:.0} allowed (16 × the patch limit): choose a larger size"
-                ),
-            });
-        }
-        let estimate = mesh::estimate(scene, size);
-        if estimate > options.max_patches as f64 {
-            return Err(Error::Option {
-                option: "patch_size",
-                problem: format!(
-                    "{size} cuts the scene's {:.1} area units into about {estimate:.0} patches, more \
-                     than the {} allowed (the solve grows as the square): choose a larger size",
-                    scene.total_area(),
-                    options.max_patches
-                ),
-            });
-        }
         let mut reporter = Reporter::new(progress);
         reporter.report(Progress::of(Phase::Meshing));
         let t = std::time::Instant::now();
@@ -211,4 +165,57 @@ pub fn patch_radiosity(
             seconds: [meshing, solving, t.elapsed().as_secs_f64()],
         })
     })
+}
+
+/// The options and the scene's camera checked, and the patch count bounded before meshing.
+fn check(scene: &Scene, options: &PatchOptions) -> Result<()> {
+    let size = options.patch_size;
+    if !(size.is_finite() && size > 0.0) {
+        return Err(Error::Option {
+            option: "patch_size",
+            problem: format!("must be a positive length, not {size}"),
+        });
+    }
+    if !(options.tolerance.is_finite() && options.tolerance > 0.0 && options.tolerance < 1.0) {
+        return Err(Error::Option {
+            option: "tolerance",
+            problem: format!("must lie in (0, 1), not {}", options.tolerance),
+        });
+    }
+    scene.camera.check()?;
+    if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
+        return Err(Error::Option {
+            option: "supersample",
+            problem: format!(
+                "{} rays per side of a pixel: it must lie in 1..={MAX_SUPERSAMPLE}",
+                options.supersample
+            ),
+        });
+    }
+    // The grids span each surface's bounding box in its plane: a thin diagonal strip or a
+    // ring holds far more cells than its area says. Bound them before allocating.
+    let cells = mesh::grid_cells(scene, size);
+    let cell_limit = 16.0 * options.max_patches as f64;
+    if cells > cell_limit {
+        return Err(Error::Option {
+            option: "patch_size",
+            problem: format!(
+                "{size} lays grids of {cells:.0} cells over the surfaces' bounding boxes, more \
+                 than the {cell_limit:.0} allowed (16 × the patch limit): choose a larger size"
+            ),
+        });
+    }
+    let estimate = mesh::estimate(scene, size);
+    if estimate > options.max_patches as f64 {
+        return Err(Error::Option {
+            option: "patch_size",
+            problem: format!(
+                "{size} cuts the scene's {:.1} area units into about {estimate:.0} patches, more \
+                 than the {} allowed (the solve grows as the square): choose a larger size",
+                scene.total_area(),
+                options.max_patches
+            ),
+        });
+    }
+    Ok(())
 }

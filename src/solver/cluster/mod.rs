@@ -92,13 +92,54 @@ pub(crate) fn shoot(
         return Ok(stats);
     }
 
-    // The tree, weighing each shooter by its radiosity (the mean radiosity is the reference
-    // the threshold is relative to).
+    // The tree, weighing each shooter by its radiosity.
+    let (weight, reference) = shooter_weights(state);
     let rho: Vec<f32> = state
         .reflectance
         .iter()
         .map(|r| r.max_element() as f32)
         .collect();
+    let tree = Tree::build(samples, &rho, &weight, cx);
+    debug_assert_eq!(tree.validate(samples), Ok(()));
+    let roots = tree.cut(group_size(n));
+    let linker = Linker {
+        tree: &tree,
+        samples,
+        maps: state.maps,
+        vis,
+        lift: settings.lift,
+        tolerance: settings.threshold * reference,
+        faint_links: !settings.exact_visibility,
+        seed: settings.seed,
+    };
+    let (groups, flow) = link_groups(&linker, &roots, settings, &mut stats, report)?;
+    let all = || groups.iter().flat_map(|g| &g.links);
+    stats.links = all().map(|l| (l.leaf.len() + l.cluster.len()) as u64).sum();
+    stats.leaf_links = all().map(|l| l.leaf.len() as u64).sum();
+    let link_bytes: usize = all().map(Links::bytes).sum();
+    if flow.is_break() {
+        stats.stop = StopReason::Stopped;
+        stats.bytes = link_bytes as u64;
+        return Ok(stats);
+    }
+    let groups = sweep(state, &tree, groups, settings, &mut stats, report)?;
+    let delivered: usize = groups
+        .iter()
+        .map(|g| g.delivered.capacity() * std::mem::size_of::<DVec3>())
+        .sum();
+    stats.bytes = (link_bytes
+        + delivered
+        + tree.nodes.len() * (std::mem::size_of::<tree::Node>() + std::mem::size_of::<Shooter>()))
+        as u64;
+    Ok(stats)
+}
+
+/// What the cluster threshold means: each shooter's weight in the links' error bound (its
+/// radiosity, but no darker than [`DARK_WEIGHT`] × the reference), and the reference radiosity
+/// the threshold is a fraction of (the area-weighted mean radiosity). A link is accepted when
+/// the radiosity error it can make is below threshold × reference.
+fn shooter_weights(state: &State) -> (Vec<f64>, f64) {
+    let samples = state.samples;
     let brightness: Vec<f64> = state.radiosity.iter().map(|b| b.max_element()).collect();
     let area: f64 = samples.area.iter().sum();
     let reference = if area > 0.0 {
@@ -111,28 +152,25 @@ pub(crate) fn shoot(
     } else {
         0.0
     };
-    let weight: Vec<f64> = brightness
+    let weight = brightness
         .iter()
         .map(|&b| b.max(DARK_WEIGHT * reference))
         .collect();
-    let tree = Tree::build(samples, &rho, &weight, cx);
-    debug_assert_eq!(tree.validate(samples), Ok(()));
-    let roots = tree.cut(group_size(n));
-    let threads = settings.threads.max(1);
+    (weight, reference)
+}
 
-    // Links, group by group.
-    let linker = Linker {
-        tree: &tree,
-        samples,
-        maps: state.maps,
-        vis,
-        lift: settings.lift,
-        tolerance: settings.threshold * reference,
-        faint_links: !settings.exact_visibility,
-        seed: settings.seed,
-    };
-    // Every pair of groups (each group with itself too), as jobs; each job's links go to
-    // its two groups, in job order.
+/// Every receiver group's links: every pair of groups (each group with itself too) is a job
+/// of the pipeline, whose links go to its two groups in job order; then one list per group.
+/// The links count against what the samples leave of the memory budget as they come in. Whether
+/// the host let the linking finish.
+fn link_groups(
+    linker: &Linker,
+    roots: &[Ref],
+    settings: &Settings,
+    stats: &mut ShootStats,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<(Vec<Group>, ControlFlow<()>)> {
+    let threads = settings.threads.max(1);
     let mut groups: Vec<Group> = roots
         .iter()
         .map(|&root| Group {
@@ -146,8 +184,7 @@ pub(crate) fn shoot(
         .collect();
     let link = |(x, y): (usize, usize)| linker.links_between(roots[x], roots[y]);
     let total = pairs.len();
-    // The links count against what the samples leave of the memory budget, as they come in:
-    // the pipeline holds at most its capacity of jobs' links beyond them.
+    // The pipeline holds at most its capacity of jobs' links beyond those counted.
     let mut held = 0usize;
     let flow = with_pool(threads, settings.capacity, &link, |pool| {
         pool.run(pairs.iter().copied(), |job, (first, second)| {
@@ -191,30 +228,36 @@ pub(crate) fn shoot(
         group[0].links = vec![joined];
         Ok(())
     })?;
-    let all = || groups.iter().flat_map(|g| &g.links);
-    stats.links = all().map(|l| (l.leaf.len() + l.cluster.len()) as u64).sum();
-    stats.leaf_links = all().map(|l| l.leaf.len() as u64).sum();
-    let link_bytes: usize = all().map(Links::bytes).sum();
-    if flow.is_break() {
-        stats.stop = StopReason::Stopped;
-        stats.bytes = link_bytes as u64;
-        return Ok(stats);
-    }
+    Ok((groups, flow))
+}
 
+/// The row sums (one sweep with unit radiosity, when asked), then sweeps until the unshot
+/// power is below the tolerance, the sweeps run out, or the host stops; the groups back.
+fn sweep(
+    state: &mut State,
+    tree: &Tree,
+    mut groups: Vec<Group>,
+    settings: &Settings,
+    stats: &mut ShootStats,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<Vec<Group>> {
+    let samples = state.samples;
+    let n = samples.len();
+    let emitted = state.ledger.emitted.element_sum();
     // What every group's sweep reads: written by the coordinator between sweeps, read by the
     // workers during them.
     let inputs = RwLock::new(Inputs::default());
     let work = |mut group: Group| -> Result<Group> {
         let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
         let sources = Sources {
-            tree: &tree,
+            tree,
             samples,
             unshot: &inputs.unshot,
             shooters: &inputs.shooters,
         };
         sources.gather(group.root, &group.links, &mut group.delivered);
         if !inputs.scales.is_empty() {
-            let first = first_member(&tree, group.root);
+            let first = first_member(tree, group.root);
             for (p, h) in group.delivered.iter_mut().enumerate() {
                 *h *= f64::from(inputs.scales[tree.order[first + p] as usize]);
             }
@@ -225,18 +268,18 @@ pub(crate) fn shoot(
         let mut inputs = inputs.write().unwrap_or_else(|e| e.into_inner());
         inputs.unshot.clear();
         inputs.unshot.extend_from_slice(unshot);
-        inputs.shooters = shooters(&tree, samples, unshot);
+        inputs.shooters = shooters(tree, samples, unshot);
         inputs.scales.clear();
         inputs.scales.extend_from_slice(scales);
     };
-    with_pool(threads, settings.capacity, &work, |pool| {
+    with_pool(settings.threads.max(1), settings.capacity, &work, |pool| {
         // Row sums: one sweep with unit radiosity everywhere, unscaled.
         if settings.normalise {
             set(&vec![DVec3::ONE; n], &[]);
             let mut kept = Vec::with_capacity(groups.len());
             let mut sums = vec![0.0f64; n];
             pool.run_all(groups.drain(..), |_, group| {
-                let first = first_member(&tree, group.root);
+                let first = first_member(tree, group.root);
                 for (p, h) in group.delivered.iter().enumerate() {
                     sums[tree.order[first + p] as usize] = h.x;
                 }
@@ -295,7 +338,7 @@ pub(crate) fn shoot(
             let (irradiance, unshot) = (&mut *state.irradiance, &mut *state.unshot);
             let reflectance = state.reflectance;
             pool.run_all(groups.drain(..), |_, group| {
-                let first = first_member(&tree, group.root);
+                let first = first_member(tree, group.root);
                 for (p, &h) in group.delivered.iter().enumerate() {
                     let k = tree.order[first + p] as usize;
                     irradiance[k] += h;
@@ -311,15 +354,7 @@ pub(crate) fn shoot(
         }
         Ok(())
     })?;
-    let delivered: usize = groups
-        .iter()
-        .map(|g| g.delivered.capacity() * std::mem::size_of::<DVec3>())
-        .sum();
-    stats.bytes = (link_bytes
-        + delivered
-        + tree.nodes.len() * (std::mem::size_of::<tree::Node>() + std::mem::size_of::<Shooter>()))
-        as u64;
-    Ok(stats)
+    Ok(groups)
 }
 
 fn first_member(tree: &Tree, r: Ref) -> usize {
