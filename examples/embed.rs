@@ -80,11 +80,7 @@ impl Visibility for BruteForce {
 /// built from the host's own triangles.
 pub fn host_scene() -> meshlight::Result<Scene> {
     let mut mesh = Mesh::default();
-    let material = |name: &str, kd: Vec3, ke: f32| Material {
-        name: name.into(),
-        kd,
-        ke: Vec3::splat(ke),
-    };
+    let material = |name: &str, kd: Vec3, ke: f32| Material::diffuse(name, kd, Vec3::splat(ke));
     mesh.materials = vec![
         material("wall", Vec3::splat(0.6), 0.0),
         material("red", Vec3::new(0.6, 0.1, 0.1), 0.0),

@@ -51,6 +51,7 @@ pub mod error;
 pub mod ies;
 mod light;
 pub mod lux;
+mod material;
 pub mod metrics;
 mod parallel;
 pub mod ply;

@@ -295,11 +295,7 @@ fn host_built_scenes_are_checked_too() {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
             triangles: vec![[0, 1, 2]],
             triangle_materials: vec![0],
-            materials: vec![Material {
-                name: "m".into(),
-                kd: Vec3::splat(kd),
-                ke: Vec3::ZERO,
-            }],
+            materials: vec![Material::diffuse("m", Vec3::splat(kd), Vec3::ZERO)],
         },
         point_lights: vec![],
         camera: Camera {

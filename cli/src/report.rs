@@ -18,6 +18,33 @@ fn rgb(v: DVec3) -> String {
     format!("{:.4} {:.4} {:.4}", v.x, v.y, v.z)
 }
 
+/// One material: its name, kind and parameters.
+fn material_line(m: &meshlight::scene::Material) -> String {
+    use meshlight::scene::Kind;
+    let mut line = format!("'{}': {}, Kd {}", m.name, m.kind.name(), v3(m.kd));
+    match m.kind {
+        Kind::Diffuse => {}
+        Kind::Specular { ks, roughness } => {
+            line += &format!(", Ks {}, roughness {roughness}", v3(ks));
+        }
+        Kind::Glass { ior, transmit, .. } => {
+            line = format!(
+                "'{}': {}, index {ior}, transmission {}",
+                m.name,
+                m.kind.name(),
+                v3(transmit)
+            );
+        }
+    }
+    if m.is_emitter() {
+        line += &format!(", Ke {}", v3(m.ke));
+    }
+    if m.two_sided {
+        line += ", two-sided";
+    }
+    line
+}
+
 /// `meshlight info`.
 pub fn info(scene: &Scene) -> String {
     let mut s = String::new();
@@ -27,6 +54,9 @@ pub fn info(scene: &Scene) -> String {
     let _ = writeln!(s, "triangles     {}", scene.triangles().len());
     let _ = writeln!(s, "surfaces      {}", scene.surfaces().len());
     let _ = writeln!(s, "materials     {}", scene.materials().len());
+    for m in scene.materials() {
+        let _ = writeln!(s, "  {}", material_line(m));
+    }
     let _ = writeln!(s, "total area    {:.6}", scene.total_area());
     let _ = writeln!(
         s,

@@ -8,6 +8,7 @@ use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::overrides::Override;
 use super::{luminance, validate, Camera, Grid, Luminaire, PointLight, SolverDefaults, Units};
 use crate::error::{Error, Result};
 use crate::ies::Photometry;
@@ -28,6 +29,22 @@ struct SceneToml {
     grid: Vec<Spanned<GridToml>>,
     #[serde(default)]
     solver: Option<Spanned<SolverToml>>,
+    #[serde(default)]
+    material: std::collections::BTreeMap<String, Spanned<MaterialToml>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialToml {
+    kind: Option<Spanned<String>>,
+    kd: Option<Spanned<[f32; 3]>>,
+    ks: Option<Spanned<[f32; 3]>>,
+    roughness: Option<Spanned<f32>>,
+    ior: Option<Spanned<f32>>,
+    transmit: Option<Spanned<[f32; 3]>>,
+    thin: Option<Spanned<bool>>,
+    ke: Option<Spanned<[f32; 3]>>,
+    two_sided: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]
@@ -87,6 +104,8 @@ pub(super) struct SceneFile {
     pub units: Units,
     pub grids: Vec<Grid>,
     pub solver: SolverDefaults,
+    /// `[material.NAME]` overrides, in name order.
+    pub overrides: Vec<Override>,
     /// The `obj =` line.
     pub obj_line: usize,
     /// Comment lines of the scene file that name the OBJ file (how to make it, say).
@@ -268,6 +287,30 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         solver.max_reflectance = s.max_reflectance;
     }
 
+    let line = |span: Range<usize>| line_of(text, span.start);
+    let rgb = |v: Spanned<[f32; 3]>| (Vec3::from(*v.get_ref()), line(v.span()));
+    let overrides = parsed
+        .material
+        .into_iter()
+        .map(|(name, table)| {
+            let table_line = line(table.span());
+            let m = table.into_inner();
+            Override {
+                name,
+                line: table_line,
+                kind: m.kind.map(|k| (k.get_ref().clone(), line(k.span()))),
+                kd: m.kd.map(rgb),
+                ks: m.ks.map(rgb),
+                roughness: m.roughness.map(|r| (*r.get_ref(), line(r.span()))),
+                ior: m.ior.map(|r| (*r.get_ref(), line(r.span()))),
+                transmit: m.transmit.map(rgb),
+                thin: m.thin.map(|b| (*b.get_ref(), line(b.span()))),
+                ke: m.ke.map(rgb),
+                two_sided: m.two_sided.map(|b| (*b.get_ref(), line(b.span()))),
+            }
+        })
+        .collect();
+
     let obj_span = parsed.obj.span();
     let obj = parsed.obj.into_inner();
     if obj.trim().is_empty() {
@@ -295,6 +338,7 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         units,
         grids,
         solver,
+        overrides,
         obj_line: line_of(text, obj_span.start),
         obj_notes,
     })

@@ -1,4 +1,4 @@
-//! The scene: triangles grouped into planar surfaces, diffuse materials, area and point lights,
+//! The scene: triangles grouped into planar surfaces, materials, area and point lights,
 //! and a camera, loaded from a scene file (TOML + OBJ/MTL, `docs/scene-format.md`) or built
 //! from parts by a host program.
 
@@ -6,7 +6,9 @@ mod camera;
 mod file;
 mod grid;
 mod luminaire;
+mod material;
 mod obj;
+mod overrides;
 mod source;
 mod surfaces;
 mod validate;
@@ -20,25 +22,8 @@ use crate::error::{Error, Result};
 pub use camera::Camera;
 pub use grid::{Grid, MAX_GRID_POINTS};
 pub use luminaire::{luminance, Luminaire, PointSource};
+pub use material::{roughness_from_ns, Kind, Material};
 pub use source::{Disk, Memory, Source};
-
-/// A diffuse material: reflectance and emitted radiance, RGB.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    /// The material's name (from `newmtl`).
-    pub name: String,
-    /// Diffuse reflectance, each channel in [0, 1).
-    pub kd: Vec3,
-    /// Emitted radiance of a Lambertian emitter (W·sr⁻¹·m⁻²); non-zero makes an area light.
-    pub ke: Vec3,
-}
-
-impl Material {
-    /// Whether faces of this material emit light.
-    pub fn is_emitter(&self) -> bool {
-        self.ke.max_element() > 0.0
-    }
-}
 
 /// A triangle of the scene, after degenerate ones were dropped.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -341,7 +326,8 @@ impl Scene {
         }
         for surface in self.surfaces.iter_mut() {
             if surface.material as usize == index {
-                surface.two_sided = self.two_sided && !material.is_emitter();
+                surface.two_sided =
+                    (self.two_sided || material.two_sided) && !material.is_emitter();
             }
         }
         self.materials[index] = material;
@@ -413,6 +399,14 @@ impl Scene {
             }
             e => e,
         })?;
+        let mut mesh = mesh;
+        overrides::apply(
+            path,
+            &file.overrides,
+            &mut mesh.materials,
+            (max_reflectance, options.strict),
+            &mut warnings,
+        )?;
         let parts = SceneParts {
             mesh,
             point_lights: file.point_lights,

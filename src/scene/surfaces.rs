@@ -125,7 +125,10 @@ pub(super) fn group(
             offset: (weighted_offset / area) as f32,
             triangles: start..triangles.len() as u32,
             area,
-            two_sided: two_sided && !materials[first.material as usize].is_emitter(),
+            two_sided: {
+                let m = &materials[first.material as usize];
+                (two_sided || m.two_sided) && !m.is_emitter()
+            },
         });
     }
     (triangles, surfaces)
@@ -199,11 +202,7 @@ mod tests {
     use super::*;
 
     fn grey() -> Vec<Material> {
-        vec![Material {
-            name: "grey".into(),
-            kd: Vec3::splat(0.5),
-            ke: Vec3::ZERO,
-        }]
+        vec![Material::diffuse("grey", Vec3::splat(0.5), Vec3::ZERO)]
     }
 
     fn mesh(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Mesh {

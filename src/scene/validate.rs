@@ -1,11 +1,12 @@
 //! Checks shared by the file loader (which adds file and line) and by `Scene::from_parts`:
-//! finite numbers, reflectance in [0, 1), non-negative emission and intensities, sane sizes.
+//! finite numbers, reflectance in [0, 1) (Kd + Ks ≤ 1), non-negative emission and intensities,
+//! glass that is only glass, sane sizes.
 
 use std::path::Path;
 
 use glam::Vec3;
 
-use super::{Material, PointLight, SceneParts};
+use super::{Kind, Material, PointLight, SceneParts};
 use crate::error::{Error, Result};
 
 /// Largest coordinate magnitude accepted: squared distances must stay finite in f32.
@@ -20,6 +21,10 @@ fn rgb(v: Vec3) -> String {
 pub(crate) enum MaterialField {
     Kd,
     Ke,
+    Ks,
+    Roughness,
+    Ior,
+    Transmit,
 }
 
 /// Why a material is invalid, if it is, and in which field.
@@ -52,7 +57,57 @@ pub(crate) fn material_field(m: &Material) -> Option<(MaterialField, String)> {
         let problem = format!("material '{}': Ke {} is negative", m.name, rgb(m.ke));
         return Some((MaterialField::Ke, problem));
     }
-    None
+    let name = &m.name;
+    match m.kind {
+        Kind::Diffuse => None,
+        Kind::Specular { ks, roughness } => {
+            if !(ks.is_finite() && ks.min_element() >= 0.0 && ks.max_element() <= 1.0) {
+                let problem = format!("material '{name}': Ks {} is outside [0, 1]", rgb(ks));
+                return Some((MaterialField::Ks, problem));
+            }
+            if (m.kd + ks).max_element() > 1.0 {
+                let problem = format!(
+                    "material '{name}': Kd {} + Ks {} exceeds 1: it would reflect more light \
+                     than arrives",
+                    rgb(m.kd),
+                    rgb(ks)
+                );
+                return Some((MaterialField::Ks, problem));
+            }
+            if !(0.0..=1.0).contains(&roughness) {
+                let problem = format!("material '{name}': roughness {roughness} is outside [0, 1]");
+                return Some((MaterialField::Roughness, problem));
+            }
+            None
+        }
+        Kind::Glass { ior, transmit, .. } => {
+            if !(1.0..=10.0).contains(&ior) {
+                let problem = format!(
+                    "material '{name}': index of refraction {ior} is outside [1, 10] (air is 1, \
+                     glass about 1.5)"
+                );
+                return Some((MaterialField::Ior, problem));
+            }
+            if !(transmit.is_finite()
+                && transmit.min_element() >= 0.0
+                && transmit.max_element() <= 1.0)
+            {
+                let problem = format!(
+                    "material '{name}': transmission filter {} is outside [0, 1]",
+                    rgb(transmit)
+                );
+                return Some((MaterialField::Transmit, problem));
+            }
+            if m.kd != Vec3::ZERO || m.ke != Vec3::ZERO {
+                let problem = format!(
+                    "material '{name}': glass neither reflects diffusely nor emits: its Kd and \
+                     Ke must be 0"
+                );
+                return Some((MaterialField::Kd, problem));
+            }
+            None
+        }
+    }
 }
 
 /// Why a `max_reflectance` (what a reflectance of exactly 1 is lowered to) is unusable.

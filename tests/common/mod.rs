@@ -11,6 +11,27 @@ use glam::Vec3;
 use meshlight::scene::{Camera, Material, Mesh, PointLight, SceneParts, SolverDefaults};
 use meshlight::{Backend, Scene};
 
+/// A specular material: Kd + Ks with roughness r (0: a mirror).
+pub fn specular(name: &str, kd: f32, ks: f32, roughness: f32) -> Material {
+    let mut m = Material::diffuse(name, Vec3::splat(kd), Vec3::ZERO);
+    m.kind = meshlight::scene::Kind::Specular {
+        ks: Vec3::splat(ks),
+        roughness,
+    };
+    m
+}
+
+/// Smooth glass of index `ior`; `thin`: a one-face pane.
+pub fn glass(name: &str, ior: f32, thin: bool) -> Material {
+    let mut m = Material::diffuse(name, Vec3::ZERO, Vec3::ZERO);
+    m.kind = meshlight::scene::Kind::Glass {
+        ior,
+        transmit: Vec3::ONE,
+        thin,
+    };
+    m
+}
+
 /// A shipped scene's path.
 pub fn shipped(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -21,11 +42,7 @@ pub fn shipped(name: &str) -> PathBuf {
 
 /// A diffuse material.
 pub fn material(name: &str, kd: f32, ke: f32) -> Material {
-    Material {
-        name: name.into(),
-        kd: Vec3::splat(kd),
-        ke: Vec3::splat(ke),
-    }
+    Material::diffuse(name, Vec3::splat(kd), Vec3::splat(ke))
 }
 
 /// Builds a mesh from quads.
