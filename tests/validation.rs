@@ -52,17 +52,6 @@ fn write(dir: &Path, files: &Files) -> PathBuf {
     dir.join("scene.toml")
 }
 
-/// Loads the files and returns the error message, which must exist.
-fn error(files: Files) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    let path = write(dir.path(), &files);
-    match Scene::load(&path) {
-        Ok(_) => panic!("the scene loaded, but an error was expected"),
-        Err(e) => e
-            .to_string()
-            .replace(&format!("{}/", dir.path().display()), ""),
-    }
-}
 
 /// Which file of the scene a case edits.
 #[derive(Clone, Copy)]
