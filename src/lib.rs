@@ -61,6 +61,7 @@ pub mod render;
 mod sampling;
 pub mod scene;
 pub mod solver;
+mod specular;
 pub mod visibility;
 
 pub use error::{Error, Result};

@@ -16,6 +16,9 @@ use crate::error::Result;
 use crate::parallel::{for_chunks_reporting, Report};
 use crate::sampling::poisson::side_seed;
 use crate::scene::{PointSource, Scene};
+use crate::specular::images::{self, Chain};
+use crate::specular::shadow::{self, LightPath};
+use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
 
 /// The most shadow rays per area light and receiver a caller may ask for.
@@ -45,7 +48,15 @@ pub struct DirectLight {
     points: Vec<PointSource>,
     light_samples: u32,
     lift: f32,
+    /// The scene's mirrors, panes and glass, and the chains of reflectors lights are seen
+    /// through; `None` where it has none (the shadow rays are then plain occlusion queries).
+    specular: Option<(Specular, Vec<Chain>)>,
+    /// Per chain, the emitters as seen through it (their mirror images).
+    images: Vec<Vec<Emitter>>,
 }
+
+/// The straight way from a receiver to a light: no reflector.
+const STRAIGHT: &[u32] = &[];
 
 /// Direct light arriving at one point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -96,6 +107,73 @@ impl DirectLight {
             points,
             light_samples: light_samples.max(1),
             lift: crate::visibility::lift(scene),
+            specular: None,
+            images: Vec::new(),
+        }
+    }
+
+    /// Direct light that also arrives by way of the scene's mirrors, panes and glass: through
+    /// mirror images of the lights up to `depth` reflections, and through glass along straight
+    /// lines (`specular::shadow`). A scene with none of them, or a depth of 0 (specular surfaces
+    /// then block light), is lit as by [`DirectLight::new`].
+    pub(crate) fn with_specular(scene: &Scene, light_samples: u32, depth: u32) -> DirectLight {
+        let mut light = DirectLight::new(scene, light_samples);
+        let spec = Specular::of(scene);
+        if depth > 0 && !spec.reflectors.is_empty() {
+            let chains = images::chains(&spec, depth);
+            light.images = chains
+                .iter()
+                .map(|c| {
+                    light
+                        .emitters
+                        .iter()
+                        .map(|e| {
+                            let normal = (c.linear.transpose() * e.normal.as_dvec3()).as_vec3();
+                            let triangles: Vec<[Vec3; 3]> = e
+                                .triangles
+                                .iter()
+                                .map(|t| t.map(|v| c.image_of(&spec, v)))
+                                .collect();
+                            Emitter {
+                                offset: normal.dot(triangles[0][0]),
+                                normal,
+                                triangles,
+                                cumulative: e.cumulative.clone(),
+                                ke: e.ke,
+                                reflects: e.reflects,
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            light.specular = Some((spec, chains));
+        }
+        light
+    }
+
+    /// The ways to the lights: straight, then each chain of reflectors.
+    fn ways(&self) -> impl Iterator<Item = Option<&Chain>> {
+        let chains = self.specular.iter().flat_map(|(_, c)| c.iter().map(Some));
+        std::iter::once(None).chain(chains)
+    }
+
+    /// The share of light arriving along each path (1 or 0 without specular surfaces);
+    /// returns the queries.
+    fn shares(&self, vis: &dyn Visibility, paths: &[LightPath], out: &mut [DVec3]) -> Result<u64> {
+        match &self.specular {
+            Some((spec, _)) => shadow::arriving(spec, vis, self.lift, paths, out),
+            None => {
+                let segments: Vec<Segment> = paths
+                    .iter()
+                    .map(|p| Segment { a: p.from, b: p.to })
+                    .collect();
+                let mut blocked = vec![false; segments.len()];
+                vis.occluded(&segments, &mut blocked)?;
+                for (o, b) in out.iter_mut().zip(blocked) {
+                    *o = if b { DVec3::ZERO } else { DVec3::ONE };
+                }
+                Ok(segments.len() as u64)
+            }
         }
     }
 
@@ -192,7 +270,8 @@ impl DirectLight {
         Ok(point_queries + area_queries)
     }
 
-    /// Point lights: I·cosθ/r² through one shadow ray each. Adds to `arrived` and
+    /// Point lights: I·cosθ/r² through one shadow ray each, and from each mirror image with
+    /// the intensity the light sends towards the image's last window. Adds to `arrived` and
     /// `unoccluded`; returns the queries.
     fn point_lights_at(
         &self,
@@ -201,37 +280,52 @@ impl DirectLight {
         arrived: &mut [DVec3],
         unoccluded: &mut [f64],
     ) -> Result<u64> {
-        let mut segments = Vec::new();
+        let mut paths = Vec::new();
         let mut lit = Vec::new();
         for (r, &(x, n)) in points.iter().enumerate() {
             let from = x + self.lift * n;
             for source in &self.points {
-                let p = source.position;
-                let d = p - x;
-                let r2 = d.length_squared();
-                let cos = n.dot(d) / r2.sqrt();
-                if cos > 0.0 && r2 > 0.0 {
-                    let intensity = source.towards(-d).as_dvec3();
-                    let contribution = intensity * f64::from(cos / r2);
-                    unoccluded[r] += contribution.element_sum();
-                    segments.push(Segment { a: from, b: p });
-                    lit.push((r, contribution));
+                for way in self.ways() {
+                    let (p, chain) = match (way, &self.specular) {
+                        (Some(c), Some((spec, _))) if c.faces(spec, x) => {
+                            (c.image_of(spec, source.position), c.reflectors.as_slice())
+                        }
+                        (Some(_), _) => continue,
+                        (None, _) => (source.position, STRAIGHT),
+                    };
+                    let d = p - x;
+                    let r2 = d.length_squared();
+                    let cos = n.dot(d) / r2.sqrt();
+                    if cos > 0.0 && r2 > 0.0 {
+                        // The direction the light leaves in: the unfolded line's, reflected.
+                        let leaving = match way {
+                            Some(c) => (c.linear * -d.as_dvec3()).as_vec3(),
+                            None => -d,
+                        };
+                        let intensity = source.towards(leaving).as_dvec3();
+                        let contribution = intensity * f64::from(cos / r2);
+                        unoccluded[r] += contribution.element_sum();
+                        paths.push(LightPath { from, to: p, chain });
+                        lit.push((r, contribution));
+                    }
                 }
             }
         }
-        let mut blocked = vec![false; segments.len()];
-        vis.occluded(&segments, &mut blocked)?;
-        for (&(r, contribution), &blocked) in lit.iter().zip(&blocked) {
-            if !blocked {
-                arrived[r] += contribution;
+        let mut shares = vec![DVec3::ZERO; paths.len()];
+        let queries = self.shares(vis, &paths, &mut shares)?;
+        for (&(r, contribution), share) in lit.iter().zip(&shares) {
+            if share.max_element() > 0.0 {
+                arrived[r] += contribution * *share;
             }
         }
-        Ok(segments.len() as u64)
+        Ok(queries)
     }
 
     /// Area lights: Lambert's exact irradiance × the visible share of stratified shadow rays
-    /// (the ratio estimator). Adds to `arrived`, `unoccluded` and `dark_emitters` (the visible
-    /// form factor to emitters that do not reflect); returns the queries.
+    /// (the ratio estimator), for each emitter and each of its mirror images (whose rays must
+    /// pass their windows; the share then carries the windows' reflectances). Adds to
+    /// `arrived`, `unoccluded` and `dark_emitters` (the visible form factor to emitters that do
+    /// not reflect, seen directly); returns the queries.
     fn area_lights_at(
         &self,
         vis: &dyn Visibility,
@@ -244,94 +338,132 @@ impl DirectLight {
         if ne == 0 {
             return Ok(0);
         }
-        // Per receiver and emitter: analytic irradiance, the unoccluded form factor (emitters
-        // that do not reflect), and [Σ weights, Σ visible weights] of its shadow rays.
-        let mut analytic = vec![DVec3::ZERO; points.len() * ne];
-        let mut factor = vec![0.0f64; points.len() * ne];
-        let mut weights = vec![[0.0f64; 2]; points.len() * ne];
-        let mut segments = Vec::new();
-        // Per shadow ray: (receiver × emitter slot, weight).
+        let ways = 1 + self.images.len();
+        let slots = ne * ways;
+        // Per receiver, emitter and way: analytic irradiance, the unoccluded form factor
+        // (emitters that do not reflect, straight), and Σ weights, Σ weights × share of its
+        // shadow rays.
+        let mut analytic = vec![DVec3::ZERO; points.len() * slots];
+        let mut factor = vec![0.0f64; points.len() * slots];
+        let mut weights = vec![(0.0f64, DVec3::ZERO); points.len() * slots];
+        let mut paths = Vec::new();
+        // Per shadow ray: (slot, weight).
         let mut rays: Vec<(usize, f64)> = Vec::new();
         for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
             let from = x + self.lift * n;
             let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 2));
-            for (e, emitter) in self.emitters.iter().enumerate() {
-                // Emitters light only what lies in front of them.
-                if emitter.normal.dot(x) - emitter.offset <= 0.0 {
-                    continue;
-                }
-                let irradiance: f64 = emitter
-                    .triangles
-                    .iter()
-                    .map(|t| polygon_irradiance(t, x, n))
-                    .sum();
-                if irradiance <= 0.0 {
-                    continue;
-                }
-                let slot = r * ne + e;
-                analytic[slot] = emitter.ke * irradiance;
-                if !emitter.reflects {
-                    factor[slot] = irradiance / std::f64::consts::PI;
-                }
-                unoccluded[r] += (emitter.ke * irradiance).element_sum();
-                let total = *emitter.cumulative.last().unwrap_or(&0.0);
-                let count = self.light_samples;
-                // A Fibonacci lattice over the emitter, shifted at random per receiver (Cranley
-                // and Patterson): as even in two dimensions as a grid for any count, and unbiased.
-                let shift = (rng.random::<f64>(), rng.random::<f64>());
-                for s in 0..count {
-                    let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
-                    let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
-                    // The first coordinate runs along the emitter's cumulative area: it picks the
-                    // triangle, and what is left of it places the point inside.
-                    let u = u1 * total;
-                    let t = emitter
-                        .cumulative
-                        .partition_point(|&c| c <= u)
-                        .min(emitter.triangles.len() - 1);
-                    let start = if t == 0 {
-                        0.0
-                    } else {
-                        emitter.cumulative[t - 1]
-                    };
-                    let within = ((u - start) / (emitter.cumulative[t] - start)).clamp(0.0, 1.0);
-                    let [a, b, c] = emitter.triangles[t];
-                    let (r1, r2) = (within.sqrt() as f32, u2 as f32);
-                    let y = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
-                    let d = y - x;
-                    let dist2 = d.length_squared();
-                    let cos_x = n.dot(d);
-                    let cos_y = -emitter.normal.dot(d);
-                    if cos_x <= 0.0 || cos_y <= 0.0 || dist2 <= 0.0 {
-                        continue;
+            for (w, way) in self.ways().enumerate() {
+                let (emitters, chain) = match (way, &self.specular) {
+                    (Some(c), Some((spec, _))) => {
+                        if !c.faces(spec, x) {
+                            continue;
+                        }
+                        (&self.images[w - 1], c.reflectors.as_slice())
                     }
-                    let weight = f64::from(cos_x * cos_y / (dist2 * dist2));
-                    weights[slot][0] += weight;
-                    segments.push(Segment {
-                        a: from,
-                        b: y + self.lift * emitter.normal,
-                    });
-                    rays.push((slot, weight));
+                    _ => (&self.emitters, STRAIGHT),
+                };
+                for (e, emitter) in emitters.iter().enumerate() {
+                    let slot = (r * ways + w) * ne + e;
+                    self.emitter_rays(
+                        emitter,
+                        (x, n, from),
+                        (slot, chain, w == 0),
+                        &mut rng,
+                        (&mut analytic, &mut factor, &mut weights),
+                        (&mut paths, &mut rays),
+                        unoccluded.get_mut(r).expect("one per receiver"),
+                    );
                 }
             }
         }
-        let mut blocked = vec![false; segments.len()];
-        vis.occluded(&segments, &mut blocked)?;
-        for (&(slot, weight), &blocked) in rays.iter().zip(&blocked) {
-            if !blocked {
-                weights[slot][1] += weight;
+        let mut shares = vec![DVec3::ZERO; paths.len()];
+        let queries = self.shares(vis, &paths, &mut shares)?;
+        for (&(slot, weight), share) in rays.iter().zip(&shares) {
+            if share.max_element() > 0.0 {
+                weights[slot].1 += weight * *share;
             }
         }
         for r in 0..points.len() {
-            for e in 0..ne {
-                let [all, visible] = weights[r * ne + e];
+            for slot in r * slots..(r + 1) * slots {
+                let (all, visible) = weights[slot];
                 if all > 0.0 {
-                    arrived[r] += analytic[r * ne + e] * (visible / all);
-                    dark_emitters[r] += factor[r * ne + e] * (visible / all);
+                    arrived[r] += analytic[slot] * (visible / all);
+                    dark_emitters[r] += factor[slot] * (visible.x / all);
                 }
             }
         }
-        Ok(segments.len() as u64)
+        Ok(queries)
+    }
+
+    /// One emitter (or its image) seen from receiver x: its analytic irradiance, and its
+    /// shadow rays on a Fibonacci lattice shifted at random per receiver (Cranley and
+    /// Patterson): as even in two dimensions as a grid for any count, and unbiased.
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn emitter_rays<'c>(
+        &self,
+        emitter: &Emitter,
+        (x, n, from): (Vec3, Vec3, Vec3),
+        (slot, chain, straight): (usize, &'c [u32], bool),
+        rng: &mut Pcg64Mcg,
+        (analytic, factor, weights): (&mut [DVec3], &mut [f64], &mut [(f64, DVec3)]),
+        (paths, rays): (&mut Vec<LightPath<'c>>, &mut Vec<(usize, f64)>),
+        unoccluded: &mut f64,
+    ) {
+        // Emitters light only what lies in front of them.
+        if emitter.normal.dot(x) - emitter.offset <= 0.0 {
+            return;
+        }
+        let irradiance: f64 = emitter
+            .triangles
+            .iter()
+            .map(|t| polygon_irradiance(t, x, n))
+            .sum();
+        if irradiance <= 0.0 {
+            return;
+        }
+        analytic[slot] = emitter.ke * irradiance;
+        if !emitter.reflects && straight {
+            factor[slot] = irradiance / std::f64::consts::PI;
+        }
+        *unoccluded += (emitter.ke * irradiance).element_sum();
+        let total = *emitter.cumulative.last().unwrap_or(&0.0);
+        let count = self.light_samples;
+        let shift = (rng.random::<f64>(), rng.random::<f64>());
+        for s in 0..count {
+            let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
+            let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
+            // The first coordinate runs along the emitter's cumulative area: it picks the
+            // triangle, and what is left of it places the point inside.
+            let u = u1 * total;
+            let t = emitter
+                .cumulative
+                .partition_point(|&c| c <= u)
+                .min(emitter.triangles.len() - 1);
+            let start = if t == 0 {
+                0.0
+            } else {
+                emitter.cumulative[t - 1]
+            };
+            let within = ((u - start) / (emitter.cumulative[t] - start)).clamp(0.0, 1.0);
+            let [a, b, c] = emitter.triangles[t];
+            let (r1, r2) = (within.sqrt() as f32, u2 as f32);
+            let y = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
+            let d = y - x;
+            let dist2 = d.length_squared();
+            let cos_x = n.dot(d);
+            let cos_y = -emitter.normal.dot(d);
+            if cos_x <= 0.0 || cos_y <= 0.0 || dist2 <= 0.0 {
+                continue;
+            }
+            let weight = f64::from(cos_x * cos_y / (dist2 * dist2));
+            weights[slot].0 += weight;
+            paths.push(LightPath {
+                from,
+                to: y + self.lift * emitter.normal,
+                chain,
+            });
+            rays.push((slot, weight));
+        }
     }
 }
 

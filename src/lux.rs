@@ -81,7 +81,8 @@ pub fn illuminance(
             ..Progress::of(Phase::DirectLight)
         };
         // Direct light: the solver's estimator at the points, facing the grid's normal.
-        let light = DirectLight::new(scene, options.light_samples);
+        let light =
+            DirectLight::with_specular(scene, options.light_samples, solution.specular_depth);
         let at: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, n)).collect();
         let ids: Vec<u32> = (0..points.len() as u32).collect();
         let (direct, _) = if reporter.report(base) {

@@ -388,9 +388,9 @@ impl<'a> Shader<'a> {
         }
         let light = match options.direct {
             // A solution without its samples' direct light cannot be split.
-            Direct::Traced { light_samples } if solution.direct.len() == s.len() => {
-                Some(DirectLight::new(scene, light_samples))
-            }
+            Direct::Traced { light_samples } if solution.direct.len() == s.len() => Some(
+                DirectLight::with_specular(scene, light_samples, solution.specular_depth),
+            ),
             _ => None,
         };
         // What sample k shows: its radiance B/π, or its irradiance; without its direct light

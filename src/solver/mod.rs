@@ -32,9 +32,12 @@ pub use crate::progress::{Control, Phase, Progress};
 pub use crate::sampling::Samples;
 use crate::sampling::{reflecting_sides, surface_of, Obstruction, SideIndex, SurfaceMap};
 use crate::scene::Scene;
+pub use crate::specular::MAX_SPECULAR_DEPTH;
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
-pub use options::{Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD};
+pub use options::{
+    Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH,
+};
 use phases::{AddedSamples, Solve};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
 pub(crate) use warm::emission as emission_of;
@@ -51,6 +54,8 @@ pub struct Solution {
     pub(crate) direct: Vec<Arrival>,
     pub(crate) epsilon: f32,
     pub(crate) epsilon_source: EpsilonSource,
+    /// The specular depth solved with (the render and the grids light with the same).
+    pub(crate) specular_depth: u32,
     pub(crate) rounds: Vec<RoundStats>,
     pub(crate) ledger: EnergyLedger,
     // What the solver and renderer need beyond the results: kept with them, not shown.
@@ -359,7 +364,7 @@ fn solve_with(
         scene,
         vis,
         options,
-        light: DirectLight::new(scene, options.light_samples),
+        light: DirectLight::with_specular(scene, options.light_samples, options.specular_depth),
         grid: (method == Method::Hierarchy).then(|| TriangleGrid::new(scene)),
         lift,
         epsilon,
@@ -377,6 +382,7 @@ fn solve_with(
         direct: Vec::new(),
         epsilon,
         epsilon_source,
+        specular_depth: options.specular_depth,
         rounds: Vec::new(),
         ledger: EnergyLedger {
             emitted: scene.emitted_power(),
@@ -467,6 +473,16 @@ fn check(options: &Options) -> Result<()> {
                 "{} must lie in 1..={}",
                 options.light_samples,
                 crate::light::MAX_LIGHT_SAMPLES
+            ),
+        );
+    }
+    if options.specular_depth > crate::specular::MAX_SPECULAR_DEPTH {
+        return fail(
+            "specular_depth",
+            format!(
+                "{} must lie in 0..={}",
+                options.specular_depth,
+                crate::specular::MAX_SPECULAR_DEPTH
             ),
         );
     }

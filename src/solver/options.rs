@@ -55,6 +55,14 @@ pub struct Options {
     /// out if it does not fit in half the rest) and its kept form factors (as many as fit).
     /// Within the budget, results do not depend on it, only time.
     pub memory_budget: usize,
+    /// How many specular bounces light may take between diffuse surfaces, 0 to
+    /// [`MAX_SPECULAR_DEPTH`](crate::solver::MAX_SPECULAR_DEPTH): mirror images of lights
+    /// across up to this many mirrors, panes and glass faces, and chains through mirrors,
+    /// glossy surfaces and glass up to this long, in the solve, the image and the grids. 0
+    /// treats every specular surface as black (its Kd still reflects). Unused in scenes
+    /// without specular materials. Each bounce more costs the rays of one more link in every
+    /// chain; what it adds falls as the product of the surfaces' reflectances.
+    pub specular_depth: u32,
     /// Worker threads (≥ 1). Results do not depend on it.
     pub threads: usize,
     /// Jobs in flight in the solver's pipeline at most (≥ 1): bounds the memory the pipeline
@@ -66,6 +74,9 @@ pub struct Options {
 
 /// Initial sample count the automatic ε aims at.
 pub const AUTO_SAMPLES: f64 = 4000.0;
+
+/// The default [`Options::specular_depth`].
+pub const DEFAULT_SPECULAR_DEPTH: u32 = 3;
 
 /// The default [`Options::cluster_threshold`].
 pub const DEFAULT_CLUSTER_THRESHOLD: f64 = 0.05;
@@ -84,6 +95,7 @@ impl Default for Options {
             cluster_threshold: DEFAULT_CLUSTER_THRESHOLD,
             exact_visibility: false,
             memory_budget: DEFAULT_MEMORY_BUDGET,
+            specular_depth: DEFAULT_SPECULAR_DEPTH,
             threads: std::thread::available_parallelism()
                 .map_or(2, |n| n.get())
                 .min(8),

@@ -136,6 +136,15 @@ impl Builder {
         }
     }
 
+    /// An axis-aligned box seen from outside (faces pointing out): a solid.
+    pub fn solid(&mut self, lo: Vec3, hi: Vec3, material: u32) {
+        let first = self.mesh.triangles.len();
+        self.room(lo, hi, material, &[]);
+        for t in &mut self.mesh.triangles[first..] {
+            t.swap(1, 2);
+        }
+    }
+
     /// The scene, with a camera.
     pub fn scene(self, camera: Camera) -> Scene {
         let parts = SceneParts {

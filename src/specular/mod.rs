@@ -1,0 +1,133 @@
+//! Light that reaches a diffuse surface by way of specular ones (`docs/method.md` §22): the
+//! paper's other future work. What a scene's mirrors, glossy surfaces and glass are
+//! (`Specular`); light paths through mirror windows and glass to a light (`shadow`); the
+//! mirror images of lights (`images`); and chains followed from a receiver through specular
+//! bounces to the diffuse surfaces and lights they end at (`gather`).
+
+pub(crate) mod images;
+pub(crate) mod shadow;
+
+use glam::Vec3;
+
+use crate::scene::{Kind, Scene};
+
+/// The most specular bounces a chain, or a mirror image of a light, may take at most.
+pub const MAX_SPECULAR_DEPTH: u32 = 16;
+
+/// How a planar surface reflects a mirror image of a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Reflects {
+    /// A mirror: Ks, the same at every angle, on its front (both sides if two-sided).
+    Mirror(Vec3),
+    /// A thin pane: R' = 2R/(1 + R) on either side.
+    Pane(f32),
+    /// A glass solid's face from outside: Fresnel R.
+    Glass(f32),
+}
+
+impl Reflects {
+    /// The reflectance at cos θ (RGB).
+    pub(crate) fn at(self, cos: f64) -> glam::DVec3 {
+        use crate::material::fresnel;
+        match self {
+            Reflects::Mirror(ks) => ks.as_dvec3(),
+            Reflects::Pane(ior) => {
+                glam::DVec3::splat(fresnel::pane_reflectance(cos, f64::from(ior)))
+            }
+            Reflects::Glass(ior) => glam::DVec3::splat(fresnel::reflectance(cos, f64::from(ior))),
+        }
+    }
+
+    /// The reflectance at normal incidence, brightest channel: what a chain of images can carry
+    /// at most, about (to leave out the images that carry next to nothing).
+    pub(crate) fn typical(self) -> f64 {
+        match self {
+            Reflects::Mirror(ks) => f64::from(ks.max_element()),
+            _ => self.at(1.0).max_element(),
+        }
+    }
+}
+
+/// A planar surface that makes mirror images of lights.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Reflector {
+    pub surface: u32,
+    /// The plane: unit normal (the front) and offset.
+    pub normal: Vec3,
+    pub offset: f32,
+    pub reflects: Reflects,
+    /// Whether its back reflects too.
+    pub both_sides: bool,
+}
+
+/// What a scene's specular surfaces are.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Specular {
+    /// Per surface: whether its material is specular (mirror, glossy or glass).
+    pub specular: Vec<bool>,
+    /// Per surface: its glass, if any (index, filter, thin).
+    pub glass: Vec<Option<(f32, Vec3, bool)>>,
+    /// The planar reflectors, in surface order.
+    pub reflectors: Vec<Reflector>,
+    /// Whether any surface is glass (shadow rays then pass through it).
+    pub any_glass: bool,
+    /// Per triangle: its surface and front normal (what a hit needs).
+    pub faces: Vec<(u32, Vec3)>,
+}
+
+impl Specular {
+    /// The scene's specular surfaces.
+    pub(crate) fn of(scene: &Scene) -> Specular {
+        let n = scene.surfaces.len();
+        let mut s = Specular {
+            specular: vec![false; n],
+            glass: vec![None; n],
+            reflectors: Vec::new(),
+            any_glass: false,
+            faces: scene
+                .triangles
+                .iter()
+                .map(|t| (t.surface, t.normal))
+                .collect(),
+        };
+        for (i, surface) in scene.surfaces.iter().enumerate() {
+            let m = &scene.materials[surface.material as usize];
+            s.specular[i] = m.is_specular();
+            let reflects = match m.kind {
+                Kind::Specular { ks, roughness } if roughness == 0.0 && ks.max_element() > 0.0 => {
+                    Some(Reflects::Mirror(ks))
+                }
+                Kind::Glass {
+                    ior,
+                    transmit,
+                    thin,
+                } => {
+                    s.glass[i] = Some((ior, transmit, thin));
+                    s.any_glass = true;
+                    Some(if thin {
+                        Reflects::Pane(ior)
+                    } else {
+                        Reflects::Glass(ior)
+                    })
+                }
+                _ => None,
+            };
+            if let Some(reflects) = reflects {
+                let pane = matches!(reflects, Reflects::Pane(_));
+                s.reflectors.push(Reflector {
+                    surface: i as u32,
+                    normal: surface.normal,
+                    offset: surface.offset,
+                    reflects,
+                    both_sides: pane || (surface.two_sided && !m.is_emitter()) || m.two_sided,
+                });
+            }
+        }
+        s
+    }
+
+    /// Whether the scene has anything specular at all.
+    pub(crate) fn any(&self) -> bool {
+        self.specular.iter().any(|&s| s)
+    }
+}
