@@ -9,6 +9,7 @@
 //! where the edge's contrast is high.
 
 pub(crate) mod image;
+pub(crate) mod interpolate;
 
 use glam::Vec3;
 
@@ -16,17 +17,15 @@ use crate::error::Result;
 use crate::light::DirectLight;
 use crate::parallel::for_chunks_reporting;
 use crate::progress::{Callback, Control, Phase, Progress, Reporter};
-use crate::sampling::{cover, is_back, side_of, surface_of, Side};
+use crate::sampling::{side_of, surface_of, Side};
 use crate::scene::Scene;
 use crate::solver::Solution;
-use crate::visibility::{Hit, Ray, Segment, Visibility};
+use crate::visibility::{Hit, Ray, Visibility};
+use interpolate::{Interpolator, Site};
 pub use image::Image;
 
 /// Edge pixels of high contrast get up to this many times `supersample` rays per side.
 const MAX_EDGE_BOOST: usize = 4;
-
-/// Kernel support: a sample reaches this many of its radii D.
-const SUPPORT: f32 = 2.0;
 
 /// Rendering settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -345,9 +344,7 @@ struct Shader<'a> {
     scene: &'a Scene,
     solution: &'a Solution,
     vis: &'a dyn Visibility,
-    lift: f32,
-    /// Largest kernel support among each side's samples (0: the side has none).
-    support: Vec<f32>,
+    interpolator: Interpolator<'a>,
     /// What the pixels hold.
     quantity: Quantity,
     /// What each sample shows (see [`Shader::new`]), computed once: hits ask for it many times.
@@ -361,17 +358,13 @@ struct Shader<'a> {
 /// Seed of the shadow rays traced at camera hits: a fixed one, so a render repeats.
 const DIRECT_SEED: u64 = 0x6d65_7368_6c69_6768;
 
-/// A hit waiting for its visibility answers.
+/// A hit waiting for its interpolation.
 struct Pending {
     side: Side,
-    /// Range of its candidates in the batch's candidate list.
-    candidates: std::ops::Range<usize>,
     /// Radiance when no sample is involved (misses, emitters without samples, black sides).
     fixed: Option<Vec3>,
     point: Vec3,
     normal: Vec3,
-    /// Whether something hovers over the hit.
-    covered: bool,
 }
 
 impl<'a> Shader<'a> {
@@ -382,15 +375,15 @@ impl<'a> Shader<'a> {
         options: &RenderOptions,
     ) -> Self {
         let s = &solution.samples;
-        let mut support = vec![0.0f32; 2 * scene.surfaces.len()];
-        for (&side, &d) in s.side.iter().zip(&s.radius) {
-            support[side as usize] = support[side as usize].max(SUPPORT * d);
-        }
         let light = match options.direct {
             // A solution without its samples' direct light cannot be split.
-            Direct::Traced { light_samples } if solution.direct.len() == s.len() => Some(
-                DirectLight::with_specular(scene, light_samples, solution.specular_depth),
-            ),
+            Direct::Traced { light_samples } if solution.direct.len() == s.len() => {
+                Some(DirectLight::with_specular(
+                    scene,
+                    light_samples,
+                    solution.specular_depth,
+                ))
+            }
             _ => None,
         };
         // What sample k shows: its radiance B/π, or its irradiance; without its direct light
@@ -414,8 +407,7 @@ impl<'a> Shader<'a> {
             scene,
             solution,
             vis,
-            lift: crate::visibility::lift(scene),
-            support,
+            interpolator: Interpolator::new(scene, solution, vis),
             quantity: options.quantity,
             values,
             light,
@@ -423,58 +415,19 @@ impl<'a> Shader<'a> {
         }
     }
 
-    /// Whether sample k is covered (`sampling::cover`); a solution without the flags has none.
-    fn sample_covered(&self, k: usize) -> bool {
-        self.solution.covered.get(k).copied().unwrap_or(false)
-    }
-
     /// Shades a batch of rays: (radiance, side seen or u32::MAX). Ray i seeds its shadow rays
     /// with id `first_id + i`. Returns visibility queries.
     fn shade(&self, rays: &[Ray], first_id: u32, out: &mut [(Vec3, u32)]) -> Result<u64> {
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(rays, &mut hits)?;
-        // Whether each hit that will be interpolated is covered, asked in one batch (hits on
-        // emitters and sides without samples show a fixed value and need not ask).
-        let interpolated: Vec<Option<(Vec3, Vec3)>> = rays
-            .iter()
-            .zip(&hits)
-            .map(|(ray, hit)| {
-                let Hit { t, triangle } = (*hit)?;
-                let tri = &self.scene.triangles[triangle as usize];
-                let back = ray.dir.dot(tri.normal) > 0.0;
-                if self.support[side_of(tri.surface, back) as usize] <= 0.0 {
-                    return None;
-                }
-                let normal = if back { -tri.normal } else { tri.normal };
-                Some((ray.origin + t * ray.dir, normal))
-            })
-            .collect();
-        let covers: Vec<Segment> = interpolated
-            .iter()
-            .flatten()
-            .map(|&(p, n)| cover::segment(p, n, self.lift, self.solution.epsilon))
-            .collect();
-        let mut answers = vec![false; covers.len()];
-        self.vis.occluded(&covers, &mut answers)?;
-        let mut answer = answers.into_iter();
-        let covered: Vec<bool> = interpolated
-            .iter()
-            .map(|h| h.is_some() && answer.next().unwrap_or(false))
-            .collect();
-        let s = &self.solution.samples;
         let mut pending = Vec::with_capacity(rays.len());
-        let mut candidates: Vec<(u32, f32)> = Vec::new();
-        let mut segments = Vec::new();
-        let mut near = Vec::new();
-        for ((ray, hit), &hit_covered) in rays.iter().zip(&hits).zip(&covered) {
+        for (ray, hit) in rays.iter().zip(&hits) {
             let Some(Hit { t, triangle }) = *hit else {
                 pending.push(Pending {
                     side: u32::MAX,
-                    candidates: 0..0,
                     fixed: Some(Vec3::ZERO),
                     point: Vec3::ZERO,
                     normal: Vec3::ZERO,
-                    covered: false,
                 });
                 continue;
             };
@@ -482,8 +435,7 @@ impl<'a> Shader<'a> {
             let back = ray.dir.dot(tri.normal) > 0.0;
             let side = side_of(tri.surface, back);
             let point = ray.origin + t * ray.dir;
-            let reach = self.support[side as usize];
-            if reach <= 0.0 {
+            if !self.interpolator.has_samples(side) {
                 let material = self.scene.material_of(tri.surface);
                 let fixed = if back || self.quantity == Quantity::Irradiance {
                     Vec3::ZERO
@@ -492,82 +444,59 @@ impl<'a> Shader<'a> {
                 };
                 pending.push(Pending {
                     side,
-                    candidates: 0..0,
                     fixed: Some(fixed),
                     point,
                     normal: tri.normal,
-                    covered: hit_covered,
                 });
                 continue;
             }
-            let map = &self.solution.maps[tri.surface as usize];
             let normal = if back { -tri.normal } else { tri.normal };
-            let from = point + self.lift * normal;
-            let uv = map.to_2d(point);
-            self.solution.index.within(s, side, uv, reach, &mut near);
-            near.sort_unstable_by_key(|&(k, _)| k);
-            let start = candidates.len();
-            let test = self.solution.obstruction.is_obstructed(side);
-            for &(k, d2) in &near {
-                let r = SUPPORT * s.radius[k as usize];
-                let q = d2 / (r * r);
-                if q < 1.0 {
-                    let w = (1.0 - q).powi(3);
-                    candidates.push((k, w));
-                    // On sides nothing stands on, every sample is in sight: no query.
-                    segments.push(test.then(|| Segment {
-                        a: from,
-                        b: s.position[k as usize] + self.lift * s.normal[k as usize],
-                    }));
-                }
-            }
             pending.push(Pending {
                 side,
-                candidates: start..candidates.len(),
                 fixed: None,
                 point,
                 normal,
-                covered: hit_covered,
             });
         }
-        let tested: Vec<Segment> = segments.iter().flatten().copied().collect();
-        let mut answers = vec![false; tested.len()];
-        self.vis.occluded(&tested, &mut answers)?;
-        let mut queries = (tested.len() + covers.len()) as u64;
-        let mut answer = answers.into_iter();
-        let blocked: Vec<bool> = segments
-            .iter()
-            .map(|s| s.is_some() && answer.next().unwrap_or(false))
+        // Whether each hit that is interpolated is covered, asked in one batch.
+        let lit: Vec<usize> = (0..pending.len())
+            .filter(|&i| pending[i].fixed.is_none())
             .collect();
+        let points: Vec<(Vec3, Vec3)> = lit
+            .iter()
+            .map(|&i| (pending[i].point, pending[i].normal))
+            .collect();
+        let covered = self.interpolator.covered(&points)?;
+        let sites: Vec<Site> = lit
+            .iter()
+            .zip(&covered)
+            .map(|(&i, &covered)| Site {
+                point: pending[i].point,
+                side: pending[i].side,
+                normal: pending[i].normal,
+                covered,
+            })
+            .collect();
+        let mut weights = Vec::new();
+        let queries = self.interpolator.weights(&sites, &mut weights)? + covered.len() as u64;
         let direct = self.direct_at(&pending, first_id)?;
         self.shadow_rays
             .fetch_add(direct.1, std::sync::atomic::Ordering::Relaxed);
+        let mut interpolated = weights.iter();
         for ((p, o), direct) in pending.iter().zip(out.iter_mut()).zip(&direct.0) {
             let radiance = match p.fixed {
                 Some(l) => l,
                 None => {
-                    // Samples covered as the hit is; any visible one if there is none such.
+                    let chosen = interpolated.next().expect("one per interpolated hit");
                     let (mut wsum, mut sum) = (0.0f64, glam::DVec3::ZERO);
-                    for alike in [true, false] {
-                        for c in p.candidates.clone() {
-                            let (k, w) = candidates[c];
-                            if !blocked[c]
-                                && (!alike || self.sample_covered(k as usize) == p.covered)
-                            {
-                                wsum += f64::from(w);
-                                sum += f64::from(w) * self.values[k as usize];
-                            }
-                        }
-                        if wsum > 0.0 {
-                            break;
-                        }
+                    for &(k, w) in chosen {
+                        wsum += f64::from(w);
+                        sum += f64::from(w) * self.values[k as usize];
                     }
                     let interpolated = if wsum > 0.0 {
                         (sum / wsum).as_vec3()
                     } else {
-                        let (l, q) = self.nearest_visible(p.side, p.point)?;
-                        queries += q;
-                        l
+                        Vec3::ZERO
                     };
                     interpolated + *direct
                 }
@@ -608,44 +537,5 @@ impl<'a> Shader<'a> {
             };
         }
         Ok((shown, queries))
-    }
-
-    /// Fallback where no sample's kernel reaches a visible hit: the nearest visible sample of
-    /// the side within a growing radius, or black if the hit is sealed off from all of them.
-    fn nearest_visible(&self, side: Side, point: Vec3) -> Result<(Vec3, u64)> {
-        let s = &self.solution.samples;
-        let surface = surface_of(side);
-        let map = &self.solution.maps[surface as usize];
-        let normal = if is_back(side) {
-            -map.normal
-        } else {
-            map.normal
-        };
-        let from = point + self.lift * normal;
-        let uv = map.to_2d(point);
-        let mut near = Vec::new();
-        let mut queries = 0;
-        let mut r = self.support[side as usize];
-        for _ in 0..4 {
-            r *= 2.0;
-            self.solution.index.within(s, side, uv, r, &mut near);
-            near.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
-            near.truncate(16);
-            let segments: Vec<Segment> = near
-                .iter()
-                .map(|&(k, _)| Segment {
-                    a: from,
-                    b: s.position[k as usize] + self.lift * s.normal[k as usize],
-                })
-                .collect();
-            let mut blocked = vec![false; segments.len()];
-            self.vis.occluded(&segments, &mut blocked)?;
-            queries += segments.len() as u64;
-            if let Some(i) = blocked.iter().position(|b| !b) {
-                let k = near[i].0 as usize;
-                return Ok((self.values[k].as_vec3(), queries));
-            }
-        }
-        Ok((Vec3::ZERO, queries))
     }
 }
