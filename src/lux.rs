@@ -12,8 +12,12 @@ use crate::error::Result;
 use crate::light::{Arrival, DirectLight};
 use crate::parallel::for_chunks_reporting;
 use crate::progress::{Callback, Phase, Progress, Reporter};
+use crate::render::interpolate::{Interpolator, Site};
 use crate::scene::{Grid, Scene};
 use crate::solver::Solution;
+use crate::specular::gather::Chains;
+use crate::specular::lights::Lights;
+use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
 
 /// How grid points are measured.
@@ -25,12 +29,17 @@ pub struct LuxOptions {
     pub seed: u64,
     /// Worker threads.
     pub threads: usize,
+    /// Chains followed from each point through specular surfaces (mirrors, glossy surfaces,
+    /// glass), 1 to [`MAX_SPECULAR_RAYS`](crate::solver::MAX_SPECULAR_RAYS); unused in scenes
+    /// without them.
+    pub specular_rays: u32,
 }
 
 impl Default for LuxOptions {
     fn default() -> Self {
         LuxOptions {
             light_samples: 64,
+            specular_rays: 256,
             seed: 1,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
@@ -63,6 +72,16 @@ pub fn illuminance(
 ) -> Result<Illuminance> {
     crate::parallel::guarded("the illuminance gather", || {
         solution.check_fits(scene)?;
+        if !(1..=crate::solver::MAX_SPECULAR_RAYS).contains(&options.specular_rays) {
+            return Err(crate::Error::argument(
+                "specular_rays",
+                format!(
+                    "{} chains per point: must lie in 1..={}",
+                    options.specular_rays,
+                    crate::solver::MAX_SPECULAR_RAYS
+                ),
+            ));
+        }
         if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&options.light_samples) {
             return Err(crate::Error::argument(
                 "light_samples",
@@ -97,9 +116,19 @@ pub fn illuminance(
             .map(|k| solution.radiosity[k] - crate::solver::emission_of(scene, s, k))
             .collect();
         let lift = crate::visibility::lift(scene);
+        let specular = specular_gather(scene, solution, vis, options)?;
         let mut gathered: Vec<Option<DVec3>> = vec![None; points.len()];
         let gather = |first: usize, out: &mut [Option<DVec3>]| {
-            for (o, &x) in out.iter_mut().zip(&points[first..]) {
+            let by_way_of_specular = match &specular {
+                Some(g) => g.at(
+                    &points[first..first + out.len()],
+                    n,
+                    first as u32,
+                    &reflected,
+                )?,
+                None => vec![DVec3::ZERO; out.len()],
+            };
+            for ((o, &x), extra) in out.iter_mut().zip(&points[first..]).zip(by_way_of_specular) {
                 let mut segments = Vec::new();
                 let mut shares = Vec::new();
                 for (k, reflected) in reflected.iter().enumerate() {
@@ -134,7 +163,8 @@ pub fn illuminance(
                         .zip(&blocked)
                         .filter(|(_, &b)| !b)
                         .map(|(e, _)| *e)
-                        .sum(),
+                        .sum::<DVec3>()
+                        + extra,
                 );
             }
             Ok(())
@@ -160,6 +190,105 @@ pub fn illuminance(
             .collect();
         Ok(Illuminance { values, measured })
     })
+}
+
+/// Light by way of specular surfaces at grid points: chains from each point
+/// (`specular::gather`), their ends interpolated from the solved samples.
+struct SpecularGather<'a> {
+    spec: Specular,
+    lights: Lights,
+    interpolator: Interpolator<'a>,
+    scene: &'a Scene,
+    vis: &'a dyn Visibility,
+    depth: u32,
+    rays: u32,
+    seed: u64,
+}
+
+/// The gather through specular surfaces, where the solution has them.
+fn specular_gather<'a>(
+    scene: &'a Scene,
+    solution: &'a Solution,
+    vis: &'a dyn Visibility,
+    options: &LuxOptions,
+) -> Result<Option<SpecularGather<'a>>> {
+    if solution.specular.is_none() {
+        return Ok(None);
+    }
+    Ok(Some(SpecularGather {
+        spec: Specular::of(scene),
+        lights: Lights::new(scene),
+        interpolator: Interpolator::new(scene, solution, vis),
+        scene,
+        vis,
+        depth: solution.specular_depth,
+        rays: options.specular_rays,
+        seed: options.seed,
+    }))
+}
+
+impl SpecularGather<'_> {
+    /// Irradiance at `points` (facing `normal`; ids from `first`) by way of specular surfaces:
+    /// the lights' light through glossy bounces, and the samples' reflected radiosity
+    /// `reflected` where the chains end.
+    fn at(
+        &self,
+        points: &[Vec3],
+        normal: Vec3,
+        first: u32,
+        reflected: &[DVec3],
+    ) -> Result<Vec<DVec3>> {
+        let has_samples = |side| self.interpolator.has_samples(side);
+        let chains = Chains {
+            scene: self.scene,
+            spec: &self.spec,
+            lights: &self.lights,
+            vis: self.vis,
+            lift: crate::visibility::lift(self.scene),
+            depth: self.depth,
+            rays: self.rays,
+            has_samples: &has_samples,
+        };
+        let receivers: Vec<(Vec3, Vec3, u32)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (p, normal, first + i as u32))
+            .collect();
+        let found = chains.follow(&receivers, self.seed)?;
+        let covered = self.interpolator.covered(
+            &found
+                .ends
+                .iter()
+                .map(|e| (e.point, e.normal))
+                .collect::<Vec<_>>(),
+        )?;
+        let sites: Vec<Site> = found
+            .ends
+            .iter()
+            .zip(covered)
+            .map(|(e, covered)| Site {
+                point: e.point,
+                side: e.side,
+                normal: e.normal,
+                covered,
+            })
+            .collect();
+        let mut weights = Vec::new();
+        self.interpolator.weights(&sites, &mut weights)?;
+        let mut out = found.direct;
+        for (e, chosen) in found.ends.iter().zip(&weights) {
+            let total: f64 = chosen.iter().map(|&(_, w)| f64::from(w)).sum();
+            if total > 0.0 {
+                let b: DVec3 = chosen
+                    .iter()
+                    .map(|&(k, w)| reflected[k as usize] * f64::from(w))
+                    .sum::<DVec3>()
+                    / total;
+                out[e.receiver as usize] += e.weight * b;
+            }
+        }
+        Ok(out)
+    }
 }
 
 /// Which of `grid`'s points lie inside a solid (a pedestal standing through a work plane): the

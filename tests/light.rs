@@ -87,6 +87,7 @@ fn half_a_light_hidden_gives_half_its_light_with_little_spread() {
         light_samples: rays,
         seed: 7,
         threads: 2,
+        ..LuxOptions::default()
     };
     for backend in backends() {
         let measure = |scene: &Scene| {

@@ -139,3 +139,97 @@ fn a_glass_slab_and_a_pane_pass_one_minus_r_over_one_plus_r_at_normal_incidence(
         }
     }
 }
+
+/// The furnace with specular faces: a closed unit box whose every face is Kd 0.3 + Ks 0.2 and
+/// emits Ke 0.1 (the shipped box with its material overridden).
+fn specular_furnace(roughness: f32) -> Scene {
+    let toml = std::fs::read_to_string(common::shipped("box")).unwrap()
+        + &format!(
+            "\n[material.grey]\nkind = \"specular\"\nkd = [0.3, 0.3, 0.3]\nks = [0.2, 0.2, 0.2]\nroughness = {roughness}\n"
+        );
+    let dir = common::shipped("box");
+    let dir = dir.parent().unwrap();
+    let files = meshlight::scene::Memory::default()
+        .with("scene.toml", toml)
+        .with("box.obj", std::fs::read(dir.join("box.obj")).unwrap())
+        .with("box.mtl", std::fs::read(dir.join("box.mtl")).unwrap());
+    Scene::load_from(&files, "scene.toml").unwrap()
+}
+
+/// The GGX lobe's albedo averaged over the hemisphere with the cosine weight, by quadrature of
+/// the formulas written out here (α = r²; D, Smith's G1, f = D G1 G1 / (4 cos cos)).
+fn ggx_mean_albedo(roughness: f64) -> f64 {
+    use std::f64::consts::PI;
+    let a2 = roughness.powi(4);
+    let d = |c: f64| {
+        let t = c * c * (a2 - 1.0) + 1.0;
+        a2 / (PI * t * t)
+    };
+    let g1 = |c: f64| 2.0 / (1.0 + (1.0 + a2 * (1.0 - c * c) / (c * c)).sqrt());
+    let n = 120;
+    let dir = |t: f64, p: f64| DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+    let (dt, dp) = (0.5 * PI / n as f64, 2.0 * PI / (2 * n) as f64);
+    let mut mean = 0.0;
+    for i in 0..n {
+        let to = (i as f64 + 0.5) * dt;
+        let wo = dir(to, 0.0);
+        let mut albedo = 0.0;
+        for j in 0..4 * n {
+            let ti = (j as f64 + 0.5) * dt / 4.0;
+            for k in 0..2 * n {
+                let wi = dir(ti, (k as f64 + 0.5) * dp);
+                let h = (wo + wi).normalize();
+                let f = d(h.z) * g1(wo.z) * g1(wi.z) / (4.0 * wo.z * wi.z);
+                albedo += f * wi.z * ti.sin() * dt / 4.0 * dp;
+            }
+        }
+        // Cosine-weighted: (1/π) ∫ a cos dω = ∫ a 2 cos sin dθ.
+        mean += albedo * 2.0 * to.cos() * to.sin() * dt;
+    }
+    mean
+}
+
+#[test]
+fn the_furnace_with_specular_faces_is_at_ke_over_one_minus_kd_minus_ks_albedo() {
+    // Every face emits Ke 0.1 and reflects Kd 0.3 + Ks 0.2. With a mirror the radiance is the
+    // same everywhere and every way: L = Ke + Kd L + Ks L = 0.1/0.5 = 0.2. A GGX lobe reflects
+    // its albedo a(θ) < 1 of Ks (single scattering): with the incident radiance nearly uniform,
+    // L̄ = Ke + Kd L̄ + Ks ā L̄, ā the lobe's cosine-weighted mean albedo (the exit angles a
+    // receiver sees in a box are nearly cosine-distributed; a(θ) varies by a few percent, so
+    // the approximation errs by well under the tolerance). The samples' radiosity is then
+    // B/π = Ke + Kd L̄.
+    for roughness in [0.0f32, 0.3] {
+        let albedo = if roughness == 0.0 {
+            1.0
+        } else {
+            ggx_mean_albedo(f64::from(roughness))
+        };
+        let l = 0.1 / (1.0 - 0.3 - 0.2 * albedo);
+        let expected = 0.1 + 0.3 * l;
+        let scene = specular_furnace(roughness);
+        for backend in backends() {
+            let vis = backend.build(&scene).unwrap();
+            let options = Options {
+                rounds: 0,
+                light_samples: 4,
+                tolerance: 1e-5,
+                ..Options::default()
+            };
+            let s = meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue)
+                .unwrap();
+            let worst = s
+                .radiosity()
+                .iter()
+                .map(|b| (b.x / std::f64::consts::PI / expected - 1.0).abs())
+                .fold(0.0, f64::max);
+            let mean = s.radiosity().iter().map(|b| b.x).sum::<f64>()
+                / s.samples().len() as f64
+                / std::f64::consts::PI;
+            assert!(
+                (mean / expected - 1.0).abs() < 0.01 && worst < 0.03,
+                "{backend}, roughness {roughness}: B/π mean {mean}, worst {worst} off \
+                 {expected} (ā {albedo})"
+            );
+        }
+    }
+}

@@ -71,6 +71,14 @@ pub struct Knobs {
     /// Refine every partly visible cluster link down to samples, however faint (slower).
     #[arg(long)]
     pub exact_visibility: bool,
+    /// Specular bounces light may take between diffuse surfaces (mirror images of lights, and
+    /// chains through mirrors, glossy surfaces and glass); 0 makes specular surfaces black.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::solver::MAX_SPECULAR_DEPTH)))]
+    pub specular_depth: Option<u32>,
+    /// Chains followed from each sample through specular surfaces (more: less noise in the
+    /// light that arrives by way of mirrors, glossy surfaces and glass).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::solver::MAX_SPECULAR_RAYS)))]
+    pub specular_rays: Option<u32>,
     /// Visibility backend: embree or bvh.
     #[arg(long)]
     pub backend: Option<Backend>,
@@ -137,6 +145,11 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 16,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
     pub direct_rays: u32,
+    /// Rays drawn from a glossy surface's lobe where a camera path meets one (and light samples
+    /// per area light there).
+    #[arg(long, default_value_t = 16,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::render::MAX_GLOSSY_RAYS)))]
+    pub glossy_rays: u32,
     /// How to compute the image: meshless (the solver), or pathtrace (the independent
     /// reference: unbiased Monte Carlo path tracing).
     #[arg(long, default_value = "meshless")]
@@ -384,6 +397,8 @@ pub fn options_from(epsilon: Option<f32>, args: &Knobs) -> anyhow::Result<Option
     o.memory_budget = args.memory_budget.unwrap_or(o.memory_budget);
     o.cluster_threshold = args.cluster_threshold.unwrap_or(o.cluster_threshold);
     o.exact_visibility |= args.exact_visibility;
+    o.specular_depth = args.specular_depth.unwrap_or(o.specular_depth);
+    o.specular_rays = args.specular_rays.unwrap_or(o.specular_rays);
     o.threads = args.threads.unwrap_or(o.threads).max(1);
     o.seed = args.seed.unwrap_or(o.seed);
     Ok(o)

@@ -73,6 +73,7 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
                 light_samples: grid_light_samples.max(1),
                 seed: options.seed,
                 threads: options.threads,
+                ..Default::default()
             };
             lux::run(&scene, &solution, vis.as_ref(), &lux, &output)
         }
@@ -130,6 +131,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
                     Some(FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
                     _ => meshlight::Quantity::Radiance,
                 },
+                glossy_rays: r.glossy_rays,
             };
             let t = std::time::Instant::now();
             let (image, stats) = progress::with_progress("render", |progress| {

@@ -406,8 +406,10 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
     );
     let emitted = s.ledger().emitted.element_sum();
     // Adaptive rounds start new samples from interpolated light, which the ledger does not
-    // follow: only a single solve's account adds up.
-    if emitted > 0.0 && s.rounds().len() == 1 {
+    // follow: only a single solve's account adds up. Specular surfaces have no samples: what
+    // they absorb is not counted, so the account is left out where a scene has them.
+    let specular = scene.materials().iter().any(|m| m.is_specular());
+    if emitted > 0.0 && s.rounds().len() == 1 && !specular {
         // Where the light went: a closed scene's "left" is what the lights that reflect
         // nothing took, plus what the transfer lost; an open one's adds its openings.
         let share = |p: f64| 100.0 * p / emitted;

@@ -119,8 +119,7 @@ impl<'a> Interpolator<'a> {
             for alike in [true, false] {
                 for c in range.clone() {
                     let (k, w) = candidates[c];
-                    if !blocked[c] && (!alike || self.sample_covered(k as usize) == site.covered)
-                    {
+                    if !blocked[c] && (!alike || self.sample_covered(k as usize) == site.covered) {
                         chosen.push((k, w));
                     }
                 }

@@ -10,6 +10,7 @@
 
 pub(crate) mod image;
 pub(crate) mod interpolate;
+mod paths;
 
 use glam::Vec3;
 
@@ -21,8 +22,8 @@ use crate::sampling::{side_of, surface_of, Side};
 use crate::scene::Scene;
 use crate::solver::Solution;
 use crate::visibility::{Hit, Ray, Visibility};
-use interpolate::{Interpolator, Site};
 pub use image::Image;
+use interpolate::{Interpolator, Site};
 
 /// Edge pixels of high contrast get up to this many times `supersample` rays per side.
 const MAX_EDGE_BOOST: usize = 4;
@@ -38,7 +39,14 @@ pub struct RenderOptions {
     pub quantity: Quantity,
     /// How a pixel gets its direct light.
     pub direct: Direct,
+    /// Rays drawn from a glossy surface's lobe where a camera path meets one (and as many light
+    /// samples per area light there), 1 to [`MAX_GLOSSY_RAYS`]: more gives smoother glossy
+    /// reflections at proportional cost. Unused in scenes without glossy surfaces.
+    pub glossy_rays: u32,
 }
+
+/// The most rays a glossy bounce may draw.
+pub const MAX_GLOSSY_RAYS: u32 = 1024;
 
 /// Where a pixel's direct light comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,6 +91,7 @@ impl Default for RenderOptions {
             supersample: 4,
             quantity: Quantity::Radiance,
             direct: Direct::Traced { light_samples: 16 },
+            glossy_rays: 16,
         }
     }
 }
@@ -130,6 +139,15 @@ pub fn render(
                     ),
                 ));
             }
+        }
+        if !(1..=MAX_GLOSSY_RAYS).contains(&options.glossy_rays) {
+            return Err(crate::Error::argument(
+                "glossy_rays",
+                format!(
+                    "{} rays per glossy bounce: must lie in 1..={MAX_GLOSSY_RAYS}",
+                    options.glossy_rays
+                ),
+            ));
         }
         let (w, h) = (camera.width as usize, camera.height as usize);
         let shader = Shader::new(scene, solution, vis, options);
@@ -349,8 +367,13 @@ struct Shader<'a> {
     quantity: Quantity,
     /// What each sample shows (see [`Shader::new`]), computed once: hits ask for it many times.
     values: Vec<glam::DVec3>,
+    /// What each sample shows with its direct light (for hits whose direct light is not traced).
+    full: Vec<glam::DVec3>,
     /// Direct light traced at the hits, when the pixels take theirs from there.
     light: Option<DirectLight>,
+    /// How camera paths go on through specular surfaces (none: the scene has none).
+    paths: Option<paths::Paths>,
+    lift: f32,
     /// Shadow rays traced so far.
     shadow_rays: std::sync::atomic::AtomicU64,
 }
@@ -359,12 +382,17 @@ struct Shader<'a> {
 const DIRECT_SEED: u64 = 0x6d65_7368_6c69_6768;
 
 /// A hit waiting for its interpolation.
+#[derive(Clone)]
 struct Pending {
     side: Side,
     /// Radiance when no sample is involved (misses, emitters without samples, black sides).
     fixed: Option<Vec3>,
     point: Vec3,
     normal: Vec3,
+    /// Whether its direct light is traced (else interpolated with the rest).
+    traced: bool,
+    /// The seed of its shadow rays.
+    id: u32,
 }
 
 impl<'a> Shader<'a> {
@@ -377,32 +405,30 @@ impl<'a> Shader<'a> {
         let s = &solution.samples;
         let light = match options.direct {
             // A solution without its samples' direct light cannot be split.
-            Direct::Traced { light_samples } if solution.direct.len() == s.len() => {
-                Some(DirectLight::with_specular(
-                    scene,
-                    light_samples,
-                    solution.specular_depth,
-                ))
-            }
+            Direct::Traced { light_samples } if solution.direct.len() == s.len() => Some(
+                DirectLight::with_specular(scene, light_samples, solution.specular_depth),
+            ),
             _ => None,
         };
         // What sample k shows: its radiance B/π, or its irradiance; without its direct light
         // when that is traced at the hits.
+        let shown = |k: usize, direct: glam::DVec3| match options.quantity {
+            Quantity::Radiance => {
+                let rho = crate::solver::reflectance_of(scene, s, k);
+                (solution.radiosity[k] - rho * direct) / std::f64::consts::PI
+            }
+            Quantity::Irradiance => solution.irradiance[k] - direct,
+        };
         let values = (0..s.len())
             .map(|k| {
                 let direct = match light {
                     Some(_) => solution.direct[k].irradiance,
                     None => glam::DVec3::ZERO,
                 };
-                match options.quantity {
-                    Quantity::Radiance => {
-                        let rho = crate::solver::reflectance_of(scene, s, k);
-                        (solution.radiosity[k] - rho * direct) / std::f64::consts::PI
-                    }
-                    Quantity::Irradiance => solution.irradiance[k] - direct,
-                }
+                shown(k, direct)
             })
             .collect();
+        let full = (0..s.len()).map(|k| shown(k, glam::DVec3::ZERO)).collect();
         Shader {
             scene,
             solution,
@@ -410,7 +436,18 @@ impl<'a> Shader<'a> {
             interpolator: Interpolator::new(scene, solution, vis),
             quantity: options.quantity,
             values,
+            full,
             light,
+            paths: {
+                let spec = crate::specular::Specular::of(scene);
+                (spec.any() && solution.specular_depth > 0).then(|| paths::Paths {
+                    lights: crate::specular::lights::Lights::new(scene),
+                    spec,
+                    depth: solution.specular_depth,
+                    glossy_rays: options.glossy_rays,
+                })
+            },
+            lift: crate::visibility::lift(scene),
             shadow_rays: std::sync::atomic::AtomicU64::new(0),
         }
     }
@@ -418,6 +455,9 @@ impl<'a> Shader<'a> {
     /// Shades a batch of rays: (radiance, side seen or u32::MAX). Ray i seeds its shadow rays
     /// with id `first_id + i`. Returns visibility queries.
     fn shade(&self, rays: &[Ray], first_id: u32, out: &mut [(Vec3, u32)]) -> Result<u64> {
+        if let Some(paths) = &self.paths {
+            return self.shade_paths(paths, rays, first_id, out);
+        }
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(rays, &mut hits)?;
         let mut pending = Vec::with_capacity(rays.len());
@@ -428,6 +468,8 @@ impl<'a> Shader<'a> {
                     fixed: Some(Vec3::ZERO),
                     point: Vec3::ZERO,
                     normal: Vec3::ZERO,
+                    traced: true,
+                    id: 0,
                 });
                 continue;
             };
@@ -447,6 +489,8 @@ impl<'a> Shader<'a> {
                     fixed: Some(fixed),
                     point,
                     normal: tri.normal,
+                    traced: true,
+                    id: 0,
                 });
                 continue;
             }
@@ -456,8 +500,20 @@ impl<'a> Shader<'a> {
                 fixed: None,
                 point,
                 normal,
+                traced: true,
+                id: first_id.wrapping_add(pending.len() as u32),
             });
         }
+        let (radiance, queries) = self.resolve(&pending)?;
+        for ((p, o), radiance) in pending.iter().zip(out.iter_mut()).zip(radiance) {
+            *o = (radiance, p.side);
+        }
+        Ok(queries)
+    }
+
+    /// The radiance (or irradiance) each pending hit shows: its fixed value, or its samples
+    /// interpolated plus its direct light traced. Returns the visibility queries too.
+    fn resolve(&self, pending: &[Pending]) -> Result<(Vec<Vec3>, u64)> {
         // Whether each hit that is interpolated is covered, asked in one batch.
         let lit: Vec<usize> = (0..pending.len())
             .filter(|&i| pending[i].fixed.is_none())
@@ -479,19 +535,26 @@ impl<'a> Shader<'a> {
             .collect();
         let mut weights = Vec::new();
         let queries = self.interpolator.weights(&sites, &mut weights)? + covered.len() as u64;
-        let direct = self.direct_at(&pending, first_id)?;
+        let direct = self.direct_at(pending)?;
         self.shadow_rays
             .fetch_add(direct.1, std::sync::atomic::Ordering::Relaxed);
         let mut interpolated = weights.iter();
-        for ((p, o), direct) in pending.iter().zip(out.iter_mut()).zip(&direct.0) {
-            let radiance = match p.fixed {
+        let mut out = Vec::with_capacity(pending.len());
+        for (p, direct) in pending.iter().zip(&direct.0) {
+            out.push(match p.fixed {
                 Some(l) => l,
                 None => {
                     let chosen = interpolated.next().expect("one per interpolated hit");
+                    // Hits whose direct light is not traced show the samples' whole light.
+                    let values = if p.traced && self.light.is_some() {
+                        &self.values
+                    } else {
+                        &self.full
+                    };
                     let (mut wsum, mut sum) = (0.0f64, glam::DVec3::ZERO);
                     for &(k, w) in chosen {
                         wsum += f64::from(w);
-                        sum += f64::from(w) * self.values[k as usize];
+                        sum += f64::from(w) * values[k as usize];
                     }
                     let interpolated = if wsum > 0.0 {
                         (sum / wsum).as_vec3()
@@ -500,30 +563,26 @@ impl<'a> Shader<'a> {
                     };
                     interpolated + *direct
                 }
-            };
-            *o = (radiance, p.side);
+            });
         }
-        Ok(queries)
+        Ok((out, queries))
     }
 
     /// The direct light each interpolated hit shows, traced there (zero where the pixels take it
     /// from the samples); and the queries it took.
-    fn direct_at(&self, pending: &[Pending], first_id: u32) -> Result<(Vec<Vec3>, u64)> {
+    fn direct_at(&self, pending: &[Pending]) -> Result<(Vec<Vec3>, u64)> {
         let mut shown = vec![Vec3::ZERO; pending.len()];
         let Some(light) = &self.light else {
             return Ok((shown, 0));
         };
         let lit: Vec<usize> = (0..pending.len())
-            .filter(|&i| pending[i].fixed.is_none())
+            .filter(|&i| pending[i].fixed.is_none() && pending[i].traced)
             .collect();
         let points: Vec<(Vec3, Vec3)> = lit
             .iter()
             .map(|&i| (pending[i].point, pending[i].normal))
             .collect();
-        let ids: Vec<u32> = lit
-            .iter()
-            .map(|&i| first_id.wrapping_add(i as u32))
-            .collect();
+        let ids: Vec<u32> = lit.iter().map(|&i| pending[i].id).collect();
         let mut arrivals = vec![crate::light::Arrival::default(); lit.len()];
         let queries = light.batch(self.vis, &points, &ids, DIRECT_SEED, &mut arrivals)?;
         for (&i, arrival) in lit.iter().zip(&arrivals) {

@@ -322,6 +322,17 @@ fn shots(
         }
         state.unshot[j] = glam::DVec3::ZERO;
         power[j] = 0.0;
+        // And by way of specular surfaces: G's column of the shooter (which may reach the
+        // shooter itself, in a mirror).
+        if let Some(g) = state.specular {
+            for (i, w) in g.column(j) {
+                let h = db * w;
+                state.irradiance[i] += h;
+                state.unshot[i] += state.reflectance[i] * h;
+                power[i] = unshot_power(state.unshot[i], samples.area[i]);
+            }
+            state.ledger.escaped -= db * g.column_flux[j];
+        }
         stats.shots += 1;
     }
     Ok(())

@@ -15,6 +15,7 @@ mod options;
 mod phases;
 mod pipeline;
 mod shooting;
+pub(crate) mod specular;
 mod stats;
 mod warm;
 
@@ -37,6 +38,7 @@ use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
 pub use options::{
     Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH,
+    MAX_SPECULAR_RAYS,
 };
 use phases::{AddedSamples, Solve};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
@@ -71,6 +73,8 @@ pub struct Solution {
     pub(crate) covered: Vec<bool>,
     /// Per sample: the factor its received form factors are scaled by (row normalisation).
     pub(crate) row_scale: Vec<f32>,
+    /// Light by way of specular surfaces (none in a scene without them).
+    pub(crate) specular: Option<specular::Transfer>,
 }
 
 impl Solution {
@@ -146,6 +150,7 @@ impl Solution {
             + vec_bytes(&self.closed)
             + vec_bytes(&self.covered)
             + vec_bytes(&self.row_scale)
+            + self.specular.as_ref().map_or(0, specular::Transfer::bytes)
             + self
                 .maps
                 .iter()
@@ -365,6 +370,11 @@ fn solve_with(
         vis,
         options,
         light: DirectLight::with_specular(scene, options.light_samples, options.specular_depth),
+        specular: {
+            let spec = crate::specular::Specular::of(scene);
+            (spec.any() && options.specular_depth > 0)
+                .then(|| (spec, crate::specular::lights::Lights::new(scene)))
+        },
         grid: (method == Method::Hierarchy).then(|| TriangleGrid::new(scene)),
         lift,
         epsilon,
@@ -394,6 +404,10 @@ fn solve_with(
         closed: Vec::new(),
         covered: Vec::new(),
         row_scale: Vec::new(),
+        specular: solve
+            .specular
+            .as_ref()
+            .map(|_| specular::Transfer::default()),
     };
     let mut added = AddedSamples {
         added: solution.samples.len(),
@@ -473,6 +487,15 @@ fn check(options: &Options) -> Result<()> {
                 "{} must lie in 1..={}",
                 options.light_samples,
                 crate::light::MAX_LIGHT_SAMPLES
+            ),
+        );
+    }
+    if options.specular_rays == 0 || options.specular_rays > MAX_SPECULAR_RAYS {
+        return fail(
+            "specular_rays",
+            format!(
+                "{} must lie in 1..={MAX_SPECULAR_RAYS}",
+                options.specular_rays
             ),
         );
     }

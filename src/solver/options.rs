@@ -63,6 +63,11 @@ pub struct Options {
     /// without specular materials. Each bounce more costs the rays of one more link in every
     /// chain; what it adds falls as the product of the surfaces' reflectances.
     pub specular_depth: u32,
+    /// Chains followed from each sample through specular surfaces, 1 to [`MAX_SPECULAR_RAYS`]:
+    /// the rays of a final gather over the part of its hemisphere that is specular. More gives
+    /// less noise in the light that arrives by way of mirrors, glossy surfaces and glass, at
+    /// proportional cost. Unused in scenes without specular materials.
+    pub specular_rays: u32,
     /// Worker threads (≥ 1). Results do not depend on it.
     pub threads: usize,
     /// Jobs in flight in the solver's pipeline at most (≥ 1): bounds the memory the pipeline
@@ -74,6 +79,9 @@ pub struct Options {
 
 /// Initial sample count the automatic ε aims at.
 pub const AUTO_SAMPLES: f64 = 4000.0;
+
+/// The most chains per sample [`Options::specular_rays`] may ask for.
+pub const MAX_SPECULAR_RAYS: u32 = 4096;
 
 /// The default [`Options::specular_depth`].
 pub const DEFAULT_SPECULAR_DEPTH: u32 = 3;
@@ -96,6 +104,7 @@ impl Default for Options {
             exact_visibility: false,
             memory_budget: DEFAULT_MEMORY_BUDGET,
             specular_depth: DEFAULT_SPECULAR_DEPTH,
+            specular_rays: 64,
             threads: std::thread::available_parallelism()
                 .map_or(2, |n| n.get())
                 .min(8),

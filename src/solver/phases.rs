@@ -21,6 +21,8 @@ use crate::sampling::{
     cover, poisson, reflecting_sides, surface_of, Samples, SideIndex, SurfaceMap,
 };
 use crate::scene::Scene;
+use crate::specular::lights::Lights;
+use crate::specular::Specular;
 use crate::visibility::Visibility;
 
 /// What one solve holds across its rounds.
@@ -34,6 +36,8 @@ pub(super) struct Solve<'a> {
     pub(super) lift: f32,
     pub(super) epsilon: f32,
     pub(super) reporter: Reporter<'a>,
+    /// The scene's specular surfaces and lights, where it has any (and the depth is not 0).
+    pub(super) specular: Option<(Specular, Lights)>,
 }
 
 /// Samples an adaptive step (or the initial placement) added.
@@ -126,6 +130,9 @@ impl Solve<'_> {
         let t = Instant::now();
         self.row_scales(solution, round, first_new)?;
         let probe_seconds = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let specular_queries = self.specular_transfer(solution)?;
+        seconds.direct += t.elapsed().as_secs_f64();
 
         let solution_bytes = solution.bytes();
         let t = Instant::now();
@@ -149,7 +156,7 @@ impl Solve<'_> {
             refined: added.refined,
             capped: added.capped,
             solution_bytes: solution_bytes as u64,
-            direct_queries,
+            direct_queries: direct_queries + specular_queries,
             areas: area_stats,
             shooting,
             seconds,
@@ -219,6 +226,27 @@ impl Solve<'_> {
             (arrivals, queries, covered)
         };
         solution.covered.extend(covered);
+        let mut queries = queries;
+        if let (Some(transfer), Some((spec, lights))) = (
+            solution.specular.as_mut().map(std::mem::take),
+            &self.specular,
+        ) {
+            // The chains of the new samples, and the lights' light they bring.
+            let mut transfer = transfer;
+            let settings = (
+                options.specular_depth,
+                options.specular_rays,
+                options.seed,
+                threads,
+            );
+            queries += if self.reporter.stopped() {
+                transfer.direct.resize(n, DVec3::ZERO);
+                0
+            } else {
+                transfer.follow(scene, solution, vis, (spec, lights), settings, first_new)?
+            };
+            solution.specular = Some(transfer);
+        }
         warm::start(
             scene,
             solution,
@@ -287,6 +315,20 @@ impl Solve<'_> {
         Ok(())
     }
 
+    /// The specular transfer matrix for this round's samples; the queries.
+    fn specular_transfer(&mut self, solution: &mut Solution) -> Result<u64> {
+        let Some(mut transfer) = solution.specular.take() else {
+            return Ok(0);
+        };
+        let queries = if self.reporter.stopped() {
+            0
+        } else {
+            transfer.build(self.scene, solution, self.vis)?
+        };
+        solution.specular = Some(transfer);
+        Ok(queries)
+    }
+
     /// Shoots (flat or clustered) with what the samples leave of the memory budget; the stats
     /// and, for the hierarchy, the seconds its links took.
     fn shoot(
@@ -318,6 +360,7 @@ impl Solve<'_> {
             row_scale: &mut solution.row_scale,
             closed: &solution.closed,
             dark_emitters: &dark_emitters,
+            specular: solution.specular.as_ref(),
         };
         let settings = Settings {
             threads: options.threads.max(1),

@@ -27,6 +27,8 @@ pub(crate) struct State<'a> {
     pub closed: &'a [bool],
     /// Per receiver, the form factor to emitters that do not reflect (see `normalise`).
     pub dark_emitters: &'a [f64],
+    /// Light by way of specular surfaces, shot beside the links.
+    pub specular: Option<&'a super::specular::Transfer>,
 }
 
 /// Settings of one solve.

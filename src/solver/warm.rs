@@ -30,6 +30,15 @@ pub(crate) fn emission(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
     std::f64::consts::PI * scene.material_of(surface_of(side)).ke.as_dvec3()
 }
 
+/// Sample k's light from the lights by way of glossy bounces (0 without specular surfaces).
+fn specular_direct(solution: &Solution, k: usize) -> DVec3 {
+    solution
+        .specular
+        .as_ref()
+        .and_then(|t| t.direct.get(k).copied())
+        .unwrap_or(DVec3::ZERO)
+}
+
 /// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their
 /// unshot radiosity for a (warm) start: see the module doc. On up to `threads` threads.
 #[allow(clippy::too_many_arguments)]
@@ -78,7 +87,10 @@ pub(crate) fn start(
                     let j = j as usize;
                     let w = f64::from((-alpha * d2.sqrt() / r).exp());
                     wsum += w;
-                    indirect += w * (shared.irradiance[j] - shared.direct[j].irradiance);
+                    // What is exact at the new sample (its direct light, and the lights' light
+                    // by way of glossy bounces) is not interpolated.
+                    let exact = shared.direct[j].irradiance + specular_direct(shared, j);
+                    indirect += w * (shared.irradiance[j] - exact);
                     shot += w * (rho * shared.irradiance[j] - shared.unshot[j]);
                 }
             }
@@ -86,7 +98,7 @@ pub(crate) fn start(
                 indirect /= wsum;
                 shot /= wsum;
             }
-            let h = arrivals[k - first_new].irradiance + indirect;
+            let h = arrivals[k - first_new].irradiance + indirect + specular_direct(shared, k);
             *o = (h, rho * h - shot, emission(scene, samples, k) + rho * h);
         }
         Ok(())

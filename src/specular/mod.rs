@@ -4,7 +4,9 @@
 //! mirror images of lights (`images`); and chains followed from a receiver through specular
 //! bounces to the diffuse surfaces and lights they end at (`gather`).
 
+pub(crate) mod gather;
 pub(crate) mod images;
+pub(crate) mod lights;
 pub(crate) mod shadow;
 
 use glam::Vec3;

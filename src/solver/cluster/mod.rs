@@ -349,6 +349,16 @@ fn sweep(
                 Ok(())
             })?;
             groups = kept;
+            // And by way of specular surfaces: G applied to what was shot.
+            if let Some(g) = state.specular {
+                let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
+                for k in 0..n {
+                    let h = g.row_times(k, &inputs.unshot);
+                    irradiance[k] += h;
+                    unshot[k] += reflectance[k] * h;
+                    delivered += h * samples.area[k];
+                }
+            }
             state.ledger.escaped += shot - delivered;
             stats.shots += 1;
         }

@@ -1,0 +1,293 @@
+//! Camera paths through mirrors, glass and glossy surfaces (`docs/method.md` §22): a camera ray
+//! that meets a specular surface goes on along its branches — a mirror's reflection, glass's
+//! reflection and refraction, both followed — up to the specular depth, and a glossy lobe's
+//! `glossy_rays` importance-sampled directions, with the lights sampled there as well
+//! (multiple importance sampling). Where a path reaches a surface with samples, that surface is
+//! shaded as a camera hit is, weighted by the path's throughput; emitters seen along a path
+//! show their radiance. Behind a glossy bounce the samples' whole light is interpolated (their
+//! direct light is not traced again for every lobe sample).
+
+use glam::{DVec3, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use super::{Pending, Quantity, Shader};
+use crate::error::Result;
+use crate::material::{branches, Branches, Lobe};
+use crate::sampling::poisson::side_seed;
+use crate::sampling::side_of;
+use crate::specular::lights::{LightSample, Lights};
+use crate::specular::shadow::{self, LightPath};
+use crate::specular::Specular;
+use crate::visibility::{Ray, Segment};
+
+/// What following specular paths needs.
+pub(super) struct Paths {
+    pub spec: Specular,
+    pub lights: Lights,
+    pub depth: u32,
+    pub glossy_rays: u32,
+}
+
+/// Paths whose throughput falls below this are not followed further.
+const NEGLIGIBLE: f64 = 1e-4;
+
+/// A ray of a camera path in flight.
+struct Branch {
+    ray: Ray,
+    /// The camera ray (pixel sample) it belongs to.
+    origin: usize,
+    weight: DVec3,
+    depth: u32,
+    /// Whether its direct light is traced where it ends: no glossy bounce came before, and at
+    /// most one mirror or glass bounce (deeper reflections take their direct light
+    /// interpolated, as their share of the pixel is small).
+    traced: bool,
+    /// Whether a glossy bounce came before (later ones draw one direction, not a fan).
+    glossed: bool,
+    /// The seed of its random numbers.
+    id: u32,
+    /// The density the glossy lobe that cast it drew it with, and how many it drew (as many
+    /// light samples were taken there): for MIS at an emitter.
+    lobe_pdf: Option<(f64, u32)>,
+}
+
+/// A light sample's shadow path waiting for its answer.
+struct Shadowed {
+    origin: usize,
+    from: Vec3,
+    sample: LightSample,
+}
+
+impl Shader<'_> {
+    /// [`Shader::shade`] in a scene with specular surfaces.
+    pub(super) fn shade_paths(
+        &self,
+        paths: &Paths,
+        rays: &[Ray],
+        first_id: u32,
+        out: &mut [(Vec3, u32)],
+    ) -> Result<u64> {
+        let lift = self.lift;
+        let mut radiance = vec![DVec3::ZERO; rays.len()];
+        let mut sides = vec![u32::MAX; rays.len()];
+        // Surfaces with samples the paths end at: (pending hit, camera ray, weight).
+        let mut ends: Vec<(Pending, usize, DVec3)> = Vec::new();
+        let mut shadowed: Vec<Shadowed> = Vec::new();
+        let mut level: Vec<Branch> = rays
+            .iter()
+            .enumerate()
+            .map(|(i, &ray)| Branch {
+                ray,
+                origin: i,
+                weight: DVec3::ONE,
+                depth: 0,
+                traced: true,
+                glossed: false,
+                id: first_id.wrapping_add(i as u32),
+                lobe_pdf: None,
+            })
+            .collect();
+        let mut queries = 0u64;
+        let mut samples = Vec::new();
+        while !level.is_empty() {
+            let level_rays: Vec<Ray> = level.iter().map(|b| b.ray).collect();
+            let mut hits = vec![None; level_rays.len()];
+            self.vis.intersect(&level_rays, &mut hits)?;
+            queries += level_rays.len() as u64;
+            let mut next = Vec::new();
+            for (b, hit) in level.iter().zip(&hits) {
+                let Some(hit) = hit else { continue };
+                let tri = &self.scene.triangles[hit.triangle as usize];
+                let dir = b.ray.dir.normalize();
+                let back = dir.dot(tri.normal) > 0.0;
+                let side = side_of(tri.surface, back);
+                if b.depth == 0 {
+                    sides[b.origin] = side;
+                }
+                let point = b.ray.origin + hit.t * b.ray.dir;
+                let material = self.scene.material_of(tri.surface);
+                let normal = if back { -tri.normal } else { tri.normal };
+                if self.interpolator.has_samples(side) {
+                    ends.push((
+                        Pending {
+                            side,
+                            fixed: None,
+                            point,
+                            normal,
+                            traced: b.traced,
+                            id: b.id,
+                        },
+                        b.origin,
+                        b.weight,
+                    ));
+                } else if !back && material.is_emitter() && self.quantity == Quantity::Radiance {
+                    // An emitter seen along the path; one a glossy lobe's sample reached counts
+                    // with its share against the lights sampled at that lobe.
+                    let mis = match b.lobe_pdf {
+                        Some((pdf, n)) => {
+                            let dist2 = f64::from(hit.t * hit.t * b.ray.dir.length_squared());
+                            let cos_y = -f64::from(dir.dot(tri.normal));
+                            paths
+                                .lights
+                                .lobe_weight(tri.surface, pdf, dist2, cos_y, n, n)
+                        }
+                        None => 1.0,
+                    };
+                    radiance[b.origin] += b.weight * material.ke.as_dvec3() * mis;
+                }
+                if b.depth >= paths.depth || self.quantity != Quantity::Radiance {
+                    continue;
+                }
+                let two_sided = self.scene.surfaces[tri.surface as usize].two_sided;
+                let on = |d: DVec3| {
+                    let n = if d.dot(tri.normal.as_dvec3()) > 0.0 {
+                        tri.normal
+                    } else {
+                        -tri.normal
+                    };
+                    point + lift * n
+                };
+                match branches(material, dir.as_dvec3(), tri.normal.as_dvec3(), two_sided) {
+                    Branches::None => {}
+                    Branches::Delta(list) => {
+                        for (k, (d, w)) in list.iter().flatten().enumerate() {
+                            let weight = b.weight * *w;
+                            if weight.max_element() < NEGLIGIBLE {
+                                continue;
+                            }
+                            next.push(Branch {
+                                ray: Ray {
+                                    origin: on(*d),
+                                    dir: d.as_vec3(),
+                                    t_min: 0.0,
+                                    t_max: f32::INFINITY,
+                                },
+                                origin: b.origin,
+                                weight,
+                                depth: b.depth + 1,
+                                traced: b.traced && b.depth == 0,
+                                glossed: b.glossed,
+                                id: side_seed(u64::from(b.id), b.depth, k as u64) as u32,
+                                lobe_pdf: None,
+                            });
+                        }
+                    }
+                    Branches::Glossy(lobe) => {
+                        let from = point + lift * normal;
+                        let mut rng = Pcg64Mcg::seed_from_u64(side_seed(
+                            0x676c_6f73_7379,
+                            b.id,
+                            u64::from(b.depth),
+                        ));
+                        let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
+                        // A fan of directions at the first glossy bounce, one at later ones.
+                        let n = if b.glossed { 1 } else { paths.glossy_rays };
+                        self.glossy(n, b, &lobe, from, &mut uniforms, &mut next);
+                        samples.clear();
+                        paths
+                            .lights
+                            .sample(&lobe, from, n, n, &mut uniforms, &mut samples);
+                        shadowed.extend(samples.drain(..).map(|mut sample| {
+                            sample.radiance *= b.weight;
+                            Shadowed {
+                                origin: b.origin,
+                                from,
+                                sample,
+                            }
+                        }));
+                    }
+                }
+            }
+            level = next;
+        }
+        queries += self.light_samples_seen(paths, &shadowed, &mut radiance)?;
+        let pending: Vec<Pending> = ends.iter().map(|(p, _, _)| p.clone()).collect();
+        let (shown, q) = self.resolve(&pending)?;
+        queries += q;
+        for ((_, origin, weight), value) in ends.iter().zip(shown) {
+            radiance[*origin] += *weight * value.as_dvec3();
+        }
+        for ((o, l), side) in out.iter_mut().zip(radiance).zip(sides) {
+            *o = (l.as_vec3(), side);
+        }
+        Ok(queries)
+    }
+
+    /// `n` directions drawn from a glossy lobe, each carrying 1/n of the path.
+    fn glossy(
+        &self,
+        n: u32,
+        b: &Branch,
+        lobe: &Lobe,
+        from: Vec3,
+        uniforms: &mut impl FnMut() -> (f64, f64),
+        next: &mut Vec<Branch>,
+    ) {
+        for j in 0..n {
+            let (u1, u2) = uniforms();
+            // Stratified along the first coordinate.
+            let u1 = (f64::from(j) + u1) / f64::from(n);
+            let Some((d, w)) = lobe.sample(u1, u2) else {
+                continue;
+            };
+            let weight = b.weight * w / f64::from(n);
+            if weight.max_element() < NEGLIGIBLE / f64::from(n) {
+                continue;
+            }
+            next.push(Branch {
+                ray: Ray {
+                    origin: from,
+                    dir: d.as_vec3(),
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                },
+                origin: b.origin,
+                weight,
+                depth: b.depth + 1,
+                traced: false,
+                glossed: true,
+                id: side_seed(u64::from(b.id), 1000 + j, u64::from(b.depth)) as u32,
+                lobe_pdf: Some((lobe.pdf(d), n)),
+            });
+        }
+    }
+
+    /// Adds the light samples taken at glossy vertices that nothing blocks; returns the queries.
+    fn light_samples_seen(
+        &self,
+        paths: &Paths,
+        shadowed: &[Shadowed],
+        radiance: &mut [DVec3],
+    ) -> Result<u64> {
+        let light_paths: Vec<LightPath> = shadowed
+            .iter()
+            .map(|s| LightPath {
+                from: s.from,
+                to: s.sample.to,
+                chain: &[],
+            })
+            .collect();
+        let mut shares = vec![DVec3::ZERO; light_paths.len()];
+        let queries = if paths.spec.any_glass {
+            shadow::arriving(&paths.spec, self.vis, self.lift, &light_paths, &mut shares)?
+        } else {
+            let segments: Vec<Segment> = light_paths
+                .iter()
+                .map(|p| Segment { a: p.from, b: p.to })
+                .collect();
+            let mut blocked = vec![false; segments.len()];
+            self.vis.occluded(&segments, &mut blocked)?;
+            for (s, b) in shares.iter_mut().zip(blocked) {
+                *s = if b { DVec3::ZERO } else { DVec3::ONE };
+            }
+            segments.len() as u64
+        };
+        self.shadow_rays
+            .fetch_add(queries, std::sync::atomic::Ordering::Relaxed);
+        for (s, share) in shadowed.iter().zip(shares) {
+            radiance[s.origin] += s.sample.radiance * share;
+        }
+        Ok(queries)
+    }
+}

@@ -1,0 +1,255 @@
+//! Chains from a receiver through specular bounces (`docs/method.md` §22): the light a diffuse
+//! point receives by way of mirrors, glossy surfaces and glass. From the receiver, rays go out
+//! over its hemisphere (cosine-weighted, on a Fibonacci lattice shifted at random per
+//! receiver); those whose first hit is specular follow its branches — a mirror's reflection,
+//! glass's reflection and refraction (both), one sampled direction of a glossy lobe — up to
+//! the specular depth. Where a chain meets a surface with samples it ends there: the receiver
+//! takes that point's reflected light, interpolated from its samples (the solver turns the ends
+//! into a sparse transfer matrix, `solver::specular`). Where it meets an emitter after a glossy
+//! bounce it takes the emitter's radiance, and at every glossy bounce the lights are sampled
+//! (multiple importance sampling against the lobe); light reaching the receiver from a light
+//! through mirrors and glass alone is the mirror images' (`images`), not the chains'.
+
+use glam::{DVec3, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use super::lights::{LightSample, Lights};
+use super::shadow::{self, LightPath};
+use super::Specular;
+use crate::error::Result;
+use crate::material::{branches, Branches};
+use crate::sampling::poisson::side_seed;
+use crate::sampling::{side_of, Side};
+use crate::scene::Scene;
+use crate::visibility::{Ray, Visibility};
+
+/// The golden ratio's fractional part: the Fibonacci lattice's second coordinate.
+const GOLDEN: f64 = 0.618_033_988_749_894_8;
+
+/// Chains whose weight falls below this share of their start are not followed further.
+const NEGLIGIBLE: f64 = 1e-4;
+
+/// Where a chain ends on a surface with samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct End {
+    /// The receiver (its index in the batch's ids, as given).
+    pub receiver: u32,
+    pub point: Vec3,
+    pub side: Side,
+    /// The side's normal.
+    pub normal: Vec3,
+    /// Irradiance at the receiver per unit radiosity leaving the end point (the chain's
+    /// throughput × 1/rays; radiosity B leaves as radiance B/π and the cosine-weighted
+    /// estimator of irradiance is π × the mean radiance).
+    pub weight: DVec3,
+}
+
+/// What the chains of a batch of receivers found.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Found {
+    /// The ends, by receiver.
+    pub ends: Vec<End>,
+    /// Per receiver: irradiance from the lights by way of glossy bounces.
+    pub direct: Vec<DVec3>,
+    pub queries: u64,
+}
+
+/// What following chains needs.
+pub(crate) struct Chains<'a> {
+    pub scene: &'a Scene,
+    pub spec: &'a Specular,
+    pub lights: &'a Lights,
+    pub vis: &'a dyn Visibility,
+    pub lift: f32,
+    pub depth: u32,
+    /// Chains per receiver.
+    pub rays: u32,
+    /// Whether a side has samples (chains end there).
+    pub has_samples: &'a (dyn Fn(Side) -> bool + Sync),
+}
+
+/// A ray of a chain in flight.
+struct Link {
+    ray: Ray,
+    receiver: u32,
+    weight: DVec3,
+    depth: u32,
+    glossy: bool,
+    lobe_pdf: Option<f64>,
+    rng: u64,
+}
+
+impl Chains<'_> {
+    /// Follows `rays` chains from each receiver (point, normal, id: the seed of its random
+    /// numbers).
+    pub(crate) fn follow(&self, receivers: &[(Vec3, Vec3, u32)], seed: u64) -> Result<Found> {
+        let mut found = Found {
+            ends: Vec::new(),
+            direct: vec![DVec3::ZERO; receivers.len()],
+            queries: 0,
+        };
+        let k = self.rays.max(1);
+        let share = 1.0 / f64::from(k);
+        let mut level: Vec<Link> = Vec::with_capacity(receivers.len() * k as usize);
+        for (r, &(x, n, id)) in receivers.iter().enumerate() {
+            let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 23));
+            let shift = (rng.random::<f64>(), rng.random::<f64>());
+            let (t, b) = n.any_orthonormal_pair();
+            for s in 0..k {
+                let u1 = ((f64::from(s) + 0.5) / f64::from(k) + shift.0).fract();
+                let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
+                let (radius, phi) = (u1.sqrt() as f32, (u2 * std::f64::consts::TAU) as f32);
+                let dir = t * (radius * phi.cos())
+                    + b * (radius * phi.sin())
+                    + n * (1.0 - u1).max(0.0).sqrt() as f32;
+                level.push(Link {
+                    ray: Ray {
+                        origin: x + self.lift * n,
+                        dir,
+                        t_min: 0.0,
+                        t_max: f32::INFINITY,
+                    },
+                    receiver: r as u32,
+                    weight: DVec3::splat(share),
+                    depth: 0,
+                    glossy: false,
+                    lobe_pdf: None,
+                    rng: side_seed(seed, id, 29 + u64::from(s)),
+                });
+            }
+        }
+        let mut samples: Vec<(u32, Vec3, LightSample)> = Vec::new();
+        let mut scratch = Vec::new();
+        while !level.is_empty() {
+            let rays: Vec<Ray> = level.iter().map(|l| l.ray).collect();
+            let mut hits = vec![None; rays.len()];
+            self.vis.intersect(&rays, &mut hits)?;
+            found.queries += rays.len() as u64;
+            let mut next = Vec::new();
+            for (l, hit) in level.iter().zip(&hits) {
+                let Some(hit) = hit else { continue };
+                let tri = &self.scene.triangles[hit.triangle as usize];
+                let specular = self.spec.specular[tri.surface as usize];
+                // A chain starts at a specular surface: what is diffuse from the receiver is
+                // the links'.
+                if l.depth == 0 && !specular {
+                    continue;
+                }
+                let dir = l.ray.dir.normalize();
+                let back = dir.dot(tri.normal) > 0.0;
+                let side = side_of(tri.surface, back);
+                let point = l.ray.origin + hit.t * l.ray.dir;
+                let material = self.scene.material_of(tri.surface);
+                if l.depth > 0 {
+                    if (self.has_samples)(side) {
+                        found.ends.push(End {
+                            receiver: l.receiver,
+                            point,
+                            side,
+                            normal: if back { -tri.normal } else { tri.normal },
+                            weight: l.weight,
+                        });
+                    }
+                    if l.glossy && !back && material.is_emitter() {
+                        let mis = l.lobe_pdf.map_or(1.0, |pdf| {
+                            let dist2 = f64::from(hit.t * hit.t * l.ray.dir.length_squared());
+                            let cos_y = -f64::from(dir.dot(tri.normal));
+                            self.lights
+                                .lobe_weight(tri.surface, pdf, dist2, cos_y, 1, 1)
+                        });
+                        found.direct[l.receiver as usize] +=
+                            std::f64::consts::PI * l.weight * material.ke.as_dvec3() * mis;
+                    }
+                }
+                if l.depth >= self.depth || !specular {
+                    continue;
+                }
+                let two_sided = self.scene.surfaces[tri.surface as usize].two_sided;
+                let off = |d: DVec3| {
+                    let n = if d.dot(tri.normal.as_dvec3()) > 0.0 {
+                        tri.normal
+                    } else {
+                        -tri.normal
+                    };
+                    point + self.lift * n
+                };
+                match branches(material, dir.as_dvec3(), tri.normal.as_dvec3(), two_sided) {
+                    Branches::None => {}
+                    Branches::Delta(list) => {
+                        for (j, (d, w)) in list.iter().flatten().enumerate() {
+                            let weight = l.weight * *w;
+                            if weight.max_element() < NEGLIGIBLE * share {
+                                continue;
+                            }
+                            next.push(Link {
+                                ray: Ray {
+                                    origin: off(*d),
+                                    dir: d.as_vec3(),
+                                    t_min: 0.0,
+                                    t_max: f32::INFINITY,
+                                },
+                                receiver: l.receiver,
+                                weight,
+                                depth: l.depth + 1,
+                                glossy: l.glossy,
+                                lobe_pdf: None,
+                                rng: side_seed(l.rng, j as u32, 31),
+                            });
+                        }
+                    }
+                    Branches::Glossy(lobe) => {
+                        let mut rng = Pcg64Mcg::seed_from_u64(l.rng);
+                        let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
+                        let from = point + self.lift * lobe.normal().as_vec3();
+                        scratch.clear();
+                        self.lights
+                            .sample(&lobe, from, 1, 1, &mut uniforms, &mut scratch);
+                        for mut sample in scratch.drain(..) {
+                            sample.radiance *= std::f64::consts::PI * l.weight;
+                            samples.push((l.receiver, from, sample));
+                        }
+                        let (u1, u2) = uniforms();
+                        if let Some((d, w)) = lobe.sample(u1, u2) {
+                            let weight = l.weight * w;
+                            if weight.max_element() >= NEGLIGIBLE * share {
+                                next.push(Link {
+                                    ray: Ray {
+                                        origin: from,
+                                        dir: d.as_vec3(),
+                                        t_min: 0.0,
+                                        t_max: f32::INFINITY,
+                                    },
+                                    receiver: l.receiver,
+                                    weight,
+                                    depth: l.depth + 1,
+                                    glossy: true,
+                                    lobe_pdf: Some(lobe.pdf(d)),
+                                    rng: side_seed(l.rng, 7, 37),
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+            level = next;
+        }
+        // The light samples taken at glossy bounces, where nothing blocks them.
+        let paths: Vec<LightPath> = samples
+            .iter()
+            .map(|(_, from, s)| LightPath {
+                from: *from,
+                to: s.to,
+                chain: &[],
+            })
+            .collect();
+        let mut shares = vec![DVec3::ZERO; paths.len()];
+        found.queries += shadow::arriving(self.spec, self.vis, self.lift, &paths, &mut shares)?;
+        for ((receiver, _, s), share) in samples.iter().zip(shares) {
+            found.direct[*receiver as usize] += s.radiance * share;
+        }
+        // By receiver (the levels came out depth by depth), in a fixed order.
+        found.ends.sort_by_key(|e| e.receiver);
+        Ok(found)
+    }
+}

@@ -1,0 +1,176 @@
+//! Light sampling at glossy vertices: a point on each area light (uniform over its area) and
+//! each point light, combined with the lobe's own samples by the power heuristic (multiple
+//! importance sampling, Veach 1997): what a glossy surface reflects of the lights, in the image,
+//! the solve's chains and the grids.
+
+use glam::{DVec3, Vec3};
+
+use crate::material::Lobe;
+use crate::scene::{PointSource, Scene};
+
+/// An emitting surface to sample.
+struct AreaLight {
+    triangles: Vec<[Vec3; 3]>,
+    cumulative: Vec<f64>,
+    area: f64,
+    ke: DVec3,
+    normal: Vec3,
+}
+
+/// The scene's lights, for sampling from glossy vertices.
+pub(crate) struct Lights {
+    areas: Vec<AreaLight>,
+    /// Per surface: its index in `areas`, if it emits.
+    of_surface: Vec<Option<u32>>,
+    points: Vec<PointSource>,
+    lift: f32,
+}
+
+/// One light sample from a glossy vertex: the light point (lifted), and the radiance it sends
+/// back along the incoming direction if nothing is in the way (MIS-weighted).
+pub(crate) struct LightSample {
+    pub to: Vec3,
+    pub radiance: DVec3,
+}
+
+impl Lights {
+    pub(crate) fn new(scene: &Scene) -> Lights {
+        let mut of_surface = vec![None; scene.surfaces.len()];
+        let mut areas = Vec::new();
+        for (s, _) in scene.emitters() {
+            let surface = &scene.surfaces[s as usize];
+            let range = surface.triangles.start as usize..surface.triangles.end as usize;
+            let mut total = 0.0;
+            let cumulative = scene.triangles[range.clone()]
+                .iter()
+                .map(|t| {
+                    total += f64::from(t.area);
+                    total
+                })
+                .collect();
+            of_surface[s as usize] = Some(areas.len() as u32);
+            areas.push(AreaLight {
+                triangles: scene.triangles[range].iter().map(|t| t.vertices).collect(),
+                cumulative,
+                area: total,
+                ke: scene.material_of(s).ke.as_dvec3(),
+                normal: surface.normal,
+            });
+        }
+        Lights {
+            areas,
+            of_surface,
+            points: scene.point_sources(),
+            lift: crate::visibility::lift(scene),
+        }
+    }
+
+    /// Samples of every light from a glossy vertex at `v` (lifted off its surface): `count` per
+    /// area light, drawn with `uniforms` (two numbers in [0, 1) each, `count` pairs), weighted
+    /// against `lobe_samples` samples of the lobe; one per point light. Only lights in front of
+    /// the lobe's side and facing `v` come out.
+    pub(crate) fn sample(
+        &self,
+        lobe: &Lobe,
+        v: Vec3,
+        count: u32,
+        lobe_samples: u32,
+        uniforms: &mut impl FnMut() -> (f64, f64),
+        out: &mut Vec<LightSample>,
+    ) {
+        for light in &self.areas {
+            for _ in 0..count {
+                let (u1, u2) = uniforms();
+                let y = light.point(u1, u2);
+                let d = (y - v).as_dvec3();
+                let dist2 = d.length_squared();
+                if dist2 <= 0.0 {
+                    continue;
+                }
+                let dir = d / dist2.sqrt();
+                let cos_y = -dir.dot(light.normal.as_dvec3());
+                if cos_y <= 0.0 || dir.dot(lobe.normal()) <= 0.0 {
+                    continue;
+                }
+                let f = lobe.eval(dir);
+                if f.max_element() <= 0.0 {
+                    continue;
+                }
+                let pdf_light = dist2 / (cos_y * light.area);
+                let weight = power(
+                    f64::from(count) * pdf_light,
+                    f64::from(lobe_samples) * lobe.pdf(dir),
+                );
+                out.push(LightSample {
+                    to: y + self.lift * light.normal,
+                    radiance: light.ke * f / (f64::from(count) * pdf_light) * weight,
+                });
+            }
+        }
+        for source in &self.points {
+            let d = (source.position - v).as_dvec3();
+            let dist2 = d.length_squared();
+            if dist2 <= 0.0 {
+                continue;
+            }
+            let dir = d / dist2.sqrt();
+            if dir.dot(lobe.normal()) <= 0.0 {
+                continue;
+            }
+            let intensity = source.towards((-dir).as_vec3()).as_dvec3();
+            out.push(LightSample {
+                to: source.position,
+                radiance: intensity * lobe.eval(dir) / dist2,
+            });
+        }
+    }
+
+    /// The power-heuristic weight of a lobe sample (density `pdf_lobe`, one of `lobe_samples`)
+    /// that hit the emitting surface `surface` at `dist2` with cos θ = `cos_y` there, against
+    /// `count` light samples of it.
+    pub(crate) fn lobe_weight(
+        &self,
+        surface: u32,
+        pdf_lobe: f64,
+        dist2: f64,
+        cos_y: f64,
+        count: u32,
+        lobe_samples: u32,
+    ) -> f64 {
+        let Some(Some(i)) = self.of_surface.get(surface as usize) else {
+            return 1.0;
+        };
+        let pdf_light = dist2 / (cos_y.max(1e-12) * self.areas[*i as usize].area);
+        power(
+            f64::from(lobe_samples) * pdf_lobe,
+            f64::from(count) * pdf_light,
+        )
+    }
+}
+
+impl AreaLight {
+    /// The point at (u1, u2): u1 along the cumulative area picks the triangle, the rest places
+    /// the point uniformly inside.
+    fn point(&self, u1: f64, u2: f64) -> Vec3 {
+        let u = u1 * self.area;
+        let t = self
+            .cumulative
+            .partition_point(|&c| c <= u)
+            .min(self.triangles.len() - 1);
+        let start = if t == 0 { 0.0 } else { self.cumulative[t - 1] };
+        let within = ((u - start) / (self.cumulative[t] - start)).clamp(0.0, 1.0);
+        let [a, b, c] = self.triangles[t];
+        let (r1, r2) = (within.sqrt() as f32, u2 as f32);
+        a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
+    }
+}
+
+/// The power heuristic's weight for the strategy of (count × density) `a` against `b`.
+fn power(a: f64, b: f64) -> f64 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 {
+        a2 / (a2 + b2)
+    } else {
+        0.0
+    }
+}
