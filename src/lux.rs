@@ -16,6 +16,7 @@ use crate::render::interpolate::{Interpolator, Site};
 use crate::scene::{Grid, Scene};
 use crate::solver::Solution;
 use crate::specular::gather::Chains;
+use crate::specular::highlight::Highlights;
 use crate::specular::lights::Lights;
 use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
@@ -39,7 +40,7 @@ impl Default for LuxOptions {
     fn default() -> Self {
         LuxOptions {
             light_samples: 64,
-            specular_rays: 256,
+            specular_rays: std::env::var("ML_RAYS").ok().and_then(|v| v.parse().ok()).unwrap_or(256),
             seed: 1,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
@@ -239,6 +240,7 @@ impl SpecularGather<'_> {
         reflected: &[DVec3],
     ) -> Result<Vec<DVec3>> {
         let has_samples = |side| self.interpolator.has_samples(side);
+        let highlights = Highlights::of(self.scene, &self.spec);
         let chains = Chains {
             scene: self.scene,
             spec: &self.spec,
@@ -248,6 +250,7 @@ impl SpecularGather<'_> {
             depth: self.depth,
             rays: self.rays,
             has_samples: &has_samples,
+            highlights: &highlights,
         };
         let receivers: Vec<(Vec3, Vec3, u32)> = points
             .iter()

@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::render::interpolate::{Interpolator, Site};
 use crate::scene::Scene;
 use crate::specular::gather::{Chains, End};
+use crate::specular::highlight::Highlights;
 use crate::specular::lights::Lights;
 use crate::specular::Specular;
 use crate::visibility::Visibility;
@@ -55,6 +56,7 @@ impl Transfer {
         let n = s.len();
         let interpolator = Interpolator::new(scene, solution, vis);
         let has_samples = |side| interpolator.has_samples(side);
+        let highlights = Highlights::of(scene, spec);
         let chains = Chains {
             scene,
             spec,
@@ -64,6 +66,7 @@ impl Transfer {
             depth,
             rays,
             has_samples: &has_samples,
+            highlights: &highlights,
         };
         let receivers: Vec<(Vec3, Vec3, u32)> = (first..n)
             .map(|k| (s.position[k], s.normal[k], k as u32))

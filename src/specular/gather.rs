@@ -14,6 +14,7 @@ use glam::{DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+use super::highlight::Highlights;
 use super::lights::{LightSample, Lights};
 use super::shadow::{self, LightPath};
 use super::Specular;
@@ -67,20 +68,191 @@ pub(crate) struct Chains<'a> {
     pub rays: u32,
     /// Whether a side has samples (chains end there).
     pub has_samples: &'a (dyn Fn(Side) -> bool + Sync),
+    /// The glossy planes highlights are drawn on.
+    pub highlights: &'a Highlights,
+}
+
+/// Highlight samples per receiver, glossy plane and light: one for every eight chains.
+fn highlight_samples(rays: u32) -> u32 {
+    rays.div_ceil(8)
+}
+
+/// A first glossy bounce on a glossy plane: what the third strategy's density needs.
+#[derive(Clone, Copy, Debug)]
+struct FirstBounce {
+    /// The receiver (lifted) and cos θ there of the direction to the bounce.
+    x: Vec3,
+    cos_x: f64,
+    /// The direction from the receiver to the bounce.
+    omega: DVec3,
+    plane: u32,
 }
 
 /// A ray of a chain in flight.
 struct Link {
     ray: Ray,
     receiver: u32,
+    /// The receiver's normal.
+    normal: Vec3,
     weight: DVec3,
     depth: u32,
     glossy: bool,
     lobe_pdf: Option<f64>,
+    /// Set when the lobe that cast it was a first bounce on a glossy plane.
+    first: Option<FirstBounce>,
     rng: u64,
 }
 
 impl Chains<'_> {
+    /// The highlight strategy's density for the path receiver → first bounce → light point
+    /// `light`, relative to the light samples' (× their density, for area lights): the
+    /// cone's density × highlight samples, over the gather's rays × cos θ/π at the receiver.
+    fn third(&self, f: &FirstBounce, light: Vec3) -> f64 {
+        if std::env::var("ML_NO_C").is_ok() {
+            return 0.0;
+        }
+        if std::env::var("ML_ONLY_C").is_ok() {
+            return 1e30;
+        }
+        let Some(plane) = self.highlights.plane_of(f.plane) else {
+            return 0.0;
+        };
+        if f.cos_x <= 0.0 {
+            return 0.0;
+        }
+        let m = f64::from(highlight_samples(self.rays));
+        let k = f64::from(self.rays.max(1));
+        m * plane.density(f.x, light, f.omega) * std::f64::consts::PI / (k * f.cos_x)
+    }
+
+    /// Highlight samples of every receiver (see `highlight`): directions drawn towards the
+    /// images of the lights in the glossy planes, kept where they meet the plane, weighed
+    /// against the gather's light and lobe samples; their light samples go to `samples` (the
+    /// irradiance at the receiver, before visibility). Returns the queries.
+    fn highlight_samples(
+        &self,
+        receivers: &[(Vec3, Vec3, u32)],
+        seed: u64,
+        samples: &mut Vec<(u32, Vec3, LightSample)>,
+    ) -> Result<u64> {
+        if self.highlights.planes.is_empty() || std::env::var("ML_NO_C").is_ok() {
+            return Ok(0);
+        }
+        let m = highlight_samples(self.rays);
+        let k = f64::from(self.rays.max(1));
+        let pi = std::f64::consts::PI;
+        // (receiver, plane, light: area index or point index, light point, ray)
+        let mut drawn: Vec<(u32, usize, Result<usize, usize>, Vec3, Ray)> = Vec::new();
+        for (r, &(x, n, id)) in receivers.iter().enumerate() {
+            let from = x + self.lift * n;
+            let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 41));
+            for (p, plane) in self.highlights.planes.iter().enumerate() {
+                if !plane.faces(x) {
+                    continue;
+                }
+                let areas = self.lights.area_lights().map(|(i, ..)| Err::<usize, usize>(i));
+                let points = (0..self.lights.point_sources().len()).map(Ok);
+                for light in areas.chain(points) {
+                    for _ in 0..m {
+                        let l = match light {
+                            Err(i) => self.lights.point_on(i, rng.random(), rng.random()),
+                            Ok(j) => self.lights.point_sources()[j].position,
+                        };
+                        let (u1, u2) = (rng.random(), rng.random());
+                        let Some(omega) = plane.draw(from, l, u1, u2) else {
+                            continue;
+                        };
+                        if f64::from(n.dot(omega.as_vec3())) <= 0.0 || !plane.faces(l) {
+                            continue;
+                        }
+                        drawn.push((
+                            r as u32,
+                            p,
+                            light,
+                            l,
+                            Ray {
+                                origin: from,
+                                dir: omega.as_vec3(),
+                                t_min: 0.0,
+                                t_max: f32::INFINITY,
+                            },
+                        ));
+                    }
+                }
+            }
+        }
+        let rays: Vec<Ray> = drawn.iter().map(|d| d.4).collect();
+        let mut hits = vec![None; rays.len()];
+        self.vis.intersect(&rays, &mut hits)?;
+        let lights: Vec<(usize, f64, DVec3, Vec3)> = self.lights.area_lights().collect();
+        for ((r, p, light, l, ray), hit) in drawn.iter().zip(&hits) {
+            let plane = &self.highlights.planes[*p];
+            let Some(hit) = hit else { continue };
+            let tri = &self.scene.triangles[hit.triangle as usize];
+            if tri.surface != plane.surface {
+                continue;
+            }
+            let omega = ray.dir.as_dvec3();
+            let y = ray.origin + hit.t * ray.dir;
+            let material = self.scene.material_of(tri.surface);
+            let two_sided = self.scene.surfaces[tri.surface as usize].two_sided;
+            let Branches::Glossy(lobe) =
+                branches(material, omega, tri.normal.as_dvec3(), two_sided)
+            else {
+                continue;
+            };
+            let from = y + self.lift * lobe.normal().as_vec3();
+            let n_x = receivers[*r as usize].1;
+            let cos_x = f64::from(n_x.dot(ray.dir));
+            let density = plane.density(ray.origin, *l, omega);
+            let (to, contribution) = match *light {
+                Err(i) => {
+                    let (_, area, ke, normal) = lights[i];
+                    let to = *l + self.lights.lift() * normal;
+                    let d = (*l - y).as_dvec3();
+                    let dist2 = d.length_squared();
+                    let dir = d / dist2.sqrt();
+                    let cos_l = -dir.dot(normal.as_dvec3());
+                    if cos_l <= 0.0 {
+                        continue;
+                    }
+                    let f = lobe.eval(dir);
+                    let geometry = cos_l / dist2;
+                    let p_c = f64::from(m) * density / area;
+                    let p_a = k * cos_x / pi / area;
+                    let p_b = k * cos_x / pi * lobe.pdf(dir) * geometry;
+                    let mut w = crate::specular::lights::power3(p_c, p_a, p_b);
+                    if std::env::var("ML_ONLY_C").is_ok() {
+                        w = 1.0;
+                    }
+                    (to, ke * f * geometry * cos_x * w / p_c)
+                }
+                Ok(j) => {
+                    let source = &self.lights.point_sources()[j];
+                    let d = (*l - y).as_dvec3();
+                    let dist2 = d.length_squared();
+                    let dir = d / dist2.sqrt();
+                    let intensity = source.towards((-dir).as_vec3()).as_dvec3();
+                    let p_c = f64::from(m) * density;
+                    let p_a = k * cos_x / pi;
+                    let w = crate::specular::lights::power(p_c, p_a);
+                    (*l, intensity * lobe.eval(dir) / dist2 * cos_x * w / p_c)
+                }
+            };
+            if contribution.max_element() > 0.0 {
+                samples.push((
+                    *r,
+                    from,
+                    LightSample {
+                        to,
+                        radiance: contribution,
+                    },
+                ));
+            }
+        }
+        Ok(rays.len() as u64)
+    }
+
     /// Follows `rays` chains from each receiver (point, normal, id: the seed of its random
     /// numbers).
     pub(crate) fn follow(&self, receivers: &[(Vec3, Vec3, u32)], seed: u64) -> Result<Found> {
@@ -111,15 +283,18 @@ impl Chains<'_> {
                         t_max: f32::INFINITY,
                     },
                     receiver: r as u32,
+                    normal: n,
                     weight: DVec3::splat(share),
                     depth: 0,
                     glossy: false,
                     lobe_pdf: None,
+                    first: None,
                     rng: side_seed(seed, id, 29 + u64::from(s)),
                 });
             }
         }
         let mut samples: Vec<(u32, Vec3, LightSample)> = Vec::new();
+        found.queries += self.highlight_samples(receivers, seed, &mut samples)?;
         let mut scratch = Vec::new();
         while !level.is_empty() {
             let rays: Vec<Ray> = level.iter().map(|l| l.ray).collect();
@@ -190,10 +365,12 @@ impl Chains<'_> {
                                     t_max: f32::INFINITY,
                                 },
                                 receiver: l.receiver,
+                                normal: l.normal,
                                 weight,
                                 depth: l.depth + 1,
                                 glossy: l.glossy,
                                 lobe_pdf: None,
+                                first: None,
                                 rng: side_seed(l.rng, j as u32, 31),
                             });
                         }
@@ -202,9 +379,29 @@ impl Chains<'_> {
                         let mut rng = Pcg64Mcg::seed_from_u64(l.rng);
                         let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
                         let from = point + self.lift * lobe.normal().as_vec3();
+                        // A first bounce on a glossy plane weighs against highlight sampling.
+                        let first = match self.highlights.plane_of(tri.surface) {
+                            Some(plane) if l.depth == 0 => Some(FirstBounce {
+                                x: l.ray.origin,
+                                cos_x: f64::from(l.normal.dot(dir)),
+                                omega: dir.as_dvec3(),
+                                plane: plane.surface,
+                            }),
+                            _ => None,
+                        };
                         scratch.clear();
-                        self.lights
-                            .sample(&lobe, from, 1, 1, &mut uniforms, &mut scratch);
+                        let third = |light: Vec3, density: Option<f64>| match first {
+                            Some(f) => self.third(&f, light) * density.unwrap_or(1.0),
+                            None => 0.0,
+                        };
+                        self.lights.sample_with(
+                            &lobe,
+                            from,
+                            (1, 1),
+                            &mut uniforms,
+                            &third,
+                            &mut scratch,
+                        );
                         for mut sample in scratch.drain(..) {
                             sample.radiance *= std::f64::consts::PI * l.weight;
                             samples.push((l.receiver, from, sample));
@@ -221,10 +418,12 @@ impl Chains<'_> {
                                         t_max: f32::INFINITY,
                                     },
                                     receiver: l.receiver,
+                                    normal: l.normal,
                                     weight,
                                     depth: l.depth + 1,
                                     glossy: true,
                                     lobe_pdf: Some(lobe.pdf(d)),
+                                    first,
                                     rng: side_seed(l.rng, 7, 37),
                                 });
                             }

@@ -78,6 +78,22 @@ impl Lights {
         uniforms: &mut impl FnMut() -> (f64, f64),
         out: &mut Vec<LightSample>,
     ) {
+        self.sample_with(lobe, v, (count, lobe_samples), uniforms, &|_, _| 0.0, out);
+    }
+
+    /// [`Lights::sample`] with a third strategy in the multiple importance sampling: `third(l,
+    /// light_density)` is its density for the path through light point `l`, in the measure of
+    /// the light samples (their solid-angle density at `v` for area lights, `None` for a point
+    /// light, whose samples then weigh against the third strategy alone).
+    pub(crate) fn sample_with(
+        &self,
+        lobe: &Lobe,
+        v: Vec3,
+        (count, lobe_samples): (u32, u32),
+        uniforms: &mut impl FnMut() -> (f64, f64),
+        third: &dyn Fn(Vec3, Option<f64>) -> f64,
+        out: &mut Vec<LightSample>,
+    ) {
         for light in &self.areas {
             for _ in 0..count {
                 let (u1, u2) = uniforms();
@@ -97,9 +113,10 @@ impl Lights {
                     continue;
                 }
                 let pdf_light = dist2 / (cos_y * light.area);
-                let weight = power(
+                let weight = power3(
                     f64::from(count) * pdf_light,
                     f64::from(lobe_samples) * lobe.pdf(dir),
+                    third(y, Some(pdf_light)),
                 );
                 out.push(LightSample {
                     to: y + self.lift * light.normal,
@@ -118,9 +135,12 @@ impl Lights {
                 continue;
             }
             let intensity = source.towards((-dir).as_vec3()).as_dvec3();
+            // Against the third strategy alone, in its own measure (`third` gives it relative
+            // to this sample's density, 1).
+            let weight = power(1.0, third(source.position, None));
             out.push(LightSample {
                 to: source.position,
-                radiance: intensity * lobe.eval(dir) / dist2,
+                radiance: intensity * lobe.eval(dir) / dist2 * weight,
             });
         }
     }
@@ -137,14 +157,51 @@ impl Lights {
         count: u32,
         lobe_samples: u32,
     ) -> f64 {
+        self.lobe_weight_with(surface, pdf_lobe, (dist2, cos_y), (count, lobe_samples), 0.0)
+    }
+
+    /// [`Lights::lobe_weight`] against a third strategy too, whose density is
+    /// `third_per_light` × the light samples' (see [`Lights::sample_with`]).
+    pub(crate) fn lobe_weight_with(
+        &self,
+        surface: u32,
+        pdf_lobe: f64,
+        (dist2, cos_y): (f64, f64),
+        (count, lobe_samples): (u32, u32),
+        third_per_light: f64,
+    ) -> f64 {
         let Some(Some(i)) = self.of_surface.get(surface as usize) else {
             return 1.0;
         };
         let pdf_light = dist2 / (cos_y.max(1e-12) * self.areas[*i as usize].area);
-        power(
+        power3(
             f64::from(lobe_samples) * pdf_lobe,
             f64::from(count) * pdf_light,
+            third_per_light * pdf_light,
         )
+    }
+
+    /// The area lights: (index, area, Ke, normal).
+    pub(crate) fn area_lights(&self) -> impl Iterator<Item = (usize, f64, DVec3, Vec3)> + '_ {
+        self.areas
+            .iter()
+            .enumerate()
+            .map(|(i, a)| (i, a.area, a.ke, a.normal))
+    }
+
+    /// A point on area light `i`, at (u1, u2).
+    pub(crate) fn point_on(&self, i: usize, u1: f64, u2: f64) -> Vec3 {
+        self.areas[i].point(u1, u2)
+    }
+
+    /// The point lights and luminaires.
+    pub(crate) fn point_sources(&self) -> &[PointSource] {
+        &self.points
+    }
+
+    /// How far light points are lifted off their emitters.
+    pub(crate) fn lift(&self) -> f32 {
+        self.lift
     }
 }
 
@@ -165,8 +222,18 @@ impl AreaLight {
     }
 }
 
+/// The power heuristic's weight for the strategy of (count × density) `a` against `b` and `c`.
+pub(crate) fn power3(a: f64, b: f64, c: f64) -> f64 {
+    let (a2, b2, c2) = (a * a, b * b, c * c);
+    if a2 + b2 + c2 > 0.0 {
+        a2 / (a2 + b2 + c2)
+    } else {
+        0.0
+    }
+}
+
 /// The power heuristic's weight for the strategy of (count × density) `a` against `b`.
-fn power(a: f64, b: f64) -> f64 {
+pub(crate) fn power(a: f64, b: f64) -> f64 {
     let (a2, b2) = (a * a, b * b);
     if a2 + b2 > 0.0 {
         a2 / (a2 + b2)

@@ -5,6 +5,7 @@
 //! bounces to the diffuse surfaces and lights they end at (`gather`).
 
 pub(crate) mod gather;
+pub(crate) mod highlight;
 pub(crate) mod images;
 pub(crate) mod lights;
 pub(crate) mod shadow;

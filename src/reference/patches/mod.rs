@@ -169,6 +169,24 @@ pub fn patch_radiosity(
 
 /// The options and the scene's camera checked, and the patch count bounded before meshing.
 fn check(scene: &Scene, options: &PatchOptions) -> Result<()> {
+    // The paper's baseline is diffuse radiosity: it would show mirrors and glass as matte.
+    let specular: Vec<String> = scene
+        .materials
+        .iter()
+        .filter(|m| m.is_specular())
+        .map(|m| format!("'{}' ({})", m.name, m.kind.name()))
+        .collect();
+    if !specular.is_empty() {
+        return Err(Error::argument(
+            "scene",
+            format!(
+                "the patch baseline models diffuse reflection only, and {} {} specular: render \
+                 it with the meshless solver or the path tracer",
+                specular.join(", "),
+                if specular.len() == 1 { "is" } else { "are" }
+            ),
+        ));
+    }
     let size = options.patch_size;
     if !(size.is_finite() && size > 0.0) {
         return Err(Error::Option {
