@@ -52,7 +52,6 @@ fn write(dir: &Path, files: &Files) -> PathBuf {
     dir.join("scene.toml")
 }
 
-
 /// Which file of the scene a case edits.
 #[derive(Clone, Copy)]
 enum In {
