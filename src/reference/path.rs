@@ -1,26 +1,60 @@
 //! An unbiased Monte Carlo path tracer for the same scenes, the reference meshless results are
-//! checked against. It shares only scene loading, the camera and the visibility backends with
-//! the meshless solver: its own light sampling, its own shading.
+//! checked against. It shares only scene loading, the camera, the visibility backends and the
+//! scattering formulas of `crate::material` (the contract's mirror, GGX lobe, Fresnel) with the
+//! meshless solver: its own light sampling, its own shading.
 //!
-//! Diffuse surfaces (Lambertian, Kd; emitters emit Ke from their fronts); next-event
-//! estimation at every bounce: every point light (one shadow ray each), and one point on an
-//! emitting triangle chosen by power, combined with cosine-sampled bounces by the power
-//! heuristic (multiple importance sampling, Veach 1997); Russian roulette from the fourth
-//! bounce. Paths advance in waves: each bounce's rays and shadow segments go to the backend in
-//! batches. Every path draws from its own generator, seeded from (seed, pixel, sample index),
-//! so the image is the same for any number of threads. Even and odd samples go to two
-//! half-images whose difference estimates the noise.
+//! Materials (`docs/scene-format.md`): Lambertian Kd (emitters emit Ke from their fronts);
+//! Kd/π + Ks·GGX (glossy); Kd/π + a mirror's Ks; glass (Fresnel and Snell, radiance ÷η²
+//! entering, ×η² leaving) and thin panes (R', T'·Tf, unbent). At a hit the next direction comes
+//! from the diffuse part, the lobe or a delta branch, each chosen with a probability
+//! proportional to the luminance of its weight (Kd, Ks, the branch's); a direction from the
+//! diffuse part or the lobe is weighed by the mixture f cos θ / (p_d·cos θ/π + p_g·pdf_GGX).
+//!
+//! Next-event estimation at every vertex with a diffuse part or a lobe: every point light and
+//! luminaire (one connection each), and one point on an emitting triangle chosen by power,
+//! combined with the bounces by the power heuristic (multiple importance sampling, Veach 1997)
+//! against the mixture's density. Connections pass thin panes, × T'(θ)·Tf each (closest-hit
+//! queries, at most 8 panes a leg); anything else blocks them. Then the same lights again
+//! through chains of up to `mirror_depth` planar mirrors (mirror surfaces with r = 0, × Ks; thin
+//! panes, × R'(θ)): the light's image across the mirror planes, each leg checked to hit its
+//! mirror first on a side that reflects, the unfolded length in the geometry term and, for
+//! area lights, in the area-to-solid-angle density. A path that leaves such a vertex and meets
+//! an emitter after nothing but planar-mirror reflections (at most `mirror_depth`) and pane
+//! crossings is exactly what those connections found: it counts with the power heuristic's
+//! weight against them (the unfolded distance again), so each such path is counted once
+//! over both. Paths from the camera through delta events alone see emitters whole, in mirrors
+//! and through glass; point lights are never seen. After any other delta event (glass's
+//! reflection and refraction, a mirror beyond `mirror_depth`) emission found counts whole.
+//!
+//! Limits. Light that reaches a diffuse or glossy surface only through a refracting solid
+//! (thick glass) is found by paths alone, which hit area lights but never point lights or
+//! luminaires: a point light behind or inside thick glass lights nothing the camera sees
+//! through that glass, and caustics of area lights through it converge slowly. Thin panes are
+//! exact both ways. Mirrors are planar (each surface its plane); the chains looked through are
+//! capped at 1,024, the depth lowered to fit. Shading points are lifted off their surfaces by
+//! 10⁻⁴ of the scene's diagonal, which shortens distances to lights by as much.
+//!
+//! Russian roulette from the fourth bounce. Paths advance in waves: each bounce's rays, shadow
+//! segments and probes go to the backend in batches. Every path draws from its own generator,
+//! seeded from (seed, pixel, sample index), so the image is the same for any number of threads;
+//! on a diffuse path the draws are those of the diffuse-only tracer, so scenes without specular
+//! materials render bit for bit as before. Even and odd samples go to two half-images whose
+//! difference estimates the noise.
 
-use glam::DVec3;
+mod mirrors;
+
+use glam::{DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use crate::error::{Error, Result};
+use crate::material::{branches, Branches, Lobe};
 use crate::parallel::for_chunks;
 use crate::progress::{Callback, Phase, Progress, Reporter};
 use crate::render::Image;
-use crate::scene::Scene;
+use crate::scene::{Kind, Scene};
 use crate::visibility::{Hit, Ray, Segment, Visibility};
+use mirrors::{Leg, Mirrors, Probe, Step, MAX_CROSSINGS, MAX_MIRROR_DEPTH};
 
 /// Path tracing settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +69,10 @@ pub struct PathOptions {
     pub threads: usize,
     /// Bounces at most (Russian roulette ends most paths far earlier).
     pub max_bounces: u32,
+    /// Planar mirrors (and thin panes' reflections) next-event estimation looks through in a
+    /// row, at most (0 to 4; lowered where a scene has so many mirrors that the chains
+    /// would exceed 1,024).
+    pub mirror_depth: u32,
 }
 
 impl Default for PathOptions {
@@ -45,6 +83,7 @@ impl Default for PathOptions {
             seed: 1,
             threads: crate::solver::Options::default().threads,
             max_bounces: 256,
+            mirror_depth: 2,
         }
     }
 }
@@ -144,15 +183,77 @@ struct Path {
     ray: Ray,
     throughput: DVec3,
     radiance: DVec3,
-    /// Solid-angle density of the bounce that cast `ray` (0 for camera rays: no MIS).
+    /// Solid-angle density with which the last non-delta vertex drew the direction `ray`
+    /// continues; 0 when nothing else could have found what the path meets next (camera rays
+    /// and what they pass by delta events, and paths after delta events light sampling does
+    /// not follow): emission found is then taken whole.
     bounce_pdf: f64,
     bounces: u32,
+    /// Distance from the last non-delta vertex to `ray`'s origin along the planar reflections
+    /// since: with the ray's hit distance, the unfolded length light sampling would see.
+    travelled: f64,
+    /// Planar-mirror reflections since the last non-delta vertex.
+    reflections: u32,
+    /// Thin panes crossed since the last vertex that changed the direction.
+    crossings: u32,
 }
 
 /// A shadow ray's contribution, if its segment is clear.
 struct Shadow {
     path: usize,
     contribution: DVec3,
+}
+
+/// What shading a wave queues: plain shadow segments (scenes without thin panes), and probes.
+#[derive(Default)]
+struct Queue {
+    segments: Vec<Segment>,
+    shadows: Vec<Shadow>,
+    probes: Vec<Probe>,
+}
+
+/// The non-delta part of a vertex's scattering (diffuse Kd, a glossy lobe), for light sampling
+/// and the weights of multiple importance sampling.
+struct Smooth {
+    /// The side's normal.
+    n: Vec3,
+    /// The surface the vertex lies on.
+    surface: u32,
+    throughput: DVec3,
+    /// throughput × Kd / π.
+    reflect: DVec3,
+    lobe: Option<Lobe>,
+    /// The probabilities of drawing the next direction from the diffuse part, and from the lobe.
+    p_diffuse: f64,
+    p_lobe: f64,
+}
+
+impl Smooth {
+    /// throughput × f cos θ towards unit `w`, `cos` = n·w > 0.
+    fn value(&self, w: DVec3, cos: f64) -> DVec3 {
+        match &self.lobe {
+            None => self.reflect * cos,
+            Some(l) => self.reflect * cos + self.throughput * l.eval(w),
+        }
+    }
+
+    /// The density of drawing `w` as the next direction (per solid angle).
+    fn pdf(&self, w: DVec3, cos: f64) -> f64 {
+        let diffuse = self.p_diffuse * cos / std::f64::consts::PI;
+        match &self.lobe {
+            None => diffuse,
+            Some(l) => diffuse + self.p_lobe * l.pdf(w),
+        }
+    }
+}
+
+/// A point drawn on an emitting triangle for next-event estimation.
+struct AreaSample {
+    y: Vec3,
+    normal: Vec3,
+    ke: DVec3,
+    /// Density per area.
+    area_pdf: f64,
 }
 
 /// Renders the scene's camera view by path tracing. `progress` hears every pass
@@ -175,11 +276,21 @@ pub fn path_trace(
                 ),
             });
         }
+        if options.mirror_depth > MAX_MIRROR_DEPTH {
+            return Err(Error::Option {
+                option: "mirror_depth",
+                problem: format!(
+                    "{} is more than {MAX_MIRROR_DEPTH} mirrors in a row",
+                    options.mirror_depth
+                ),
+            });
+        }
         scene.camera.check()?;
         let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
         let pixels = w * h;
         let lights = Lights::new(scene);
         let lift = crate::visibility::lift(scene);
+        let mirrors = Mirrors::new(scene, options.mirror_depth, lift);
         let threads = options.threads.max(1);
         // Per pixel: sums of the even and of the odd samples.
         let mut sums = vec![[DVec3::ZERO; 2]; pixels];
@@ -204,6 +315,7 @@ pub fn path_trace(
                 scene,
                 vis,
                 lights: &lights,
+                mirrors: &mirrors,
                 points: &points,
                 lift,
                 seed: options.seed,
@@ -265,6 +377,7 @@ struct Tracer<'a> {
     scene: &'a Scene,
     vis: &'a dyn Visibility,
     lights: &'a Lights,
+    mirrors: &'a Mirrors,
     /// Point lights and luminaires.
     points: &'a [crate::scene::PointSource],
     lift: f32,
@@ -311,14 +424,16 @@ impl Tracer<'_> {
                     radiance: DVec3::ZERO,
                     bounce_pdf: 0.0,
                     bounces: 0,
+                    travelled: 0.0,
+                    reflections: 0,
+                    crossings: 0,
                 });
             }
         }
         let mut rays = 0u64;
         let mut batch: Vec<Ray> = Vec::new();
         let mut hits: Vec<Option<Hit>> = Vec::new();
-        let mut segments: Vec<Segment> = Vec::new();
-        let mut shadows: Vec<Shadow> = Vec::new();
+        let mut queue = Queue::default();
         let mut blocked: Vec<bool> = Vec::new();
         while !paths.is_empty() {
             batch.clear();
@@ -327,21 +442,23 @@ impl Tracer<'_> {
             hits.resize(batch.len(), None);
             self.vis.intersect(&batch, &mut hits)?;
             rays += batch.len() as u64;
-            segments.clear();
-            shadows.clear();
+            queue.segments.clear();
+            queue.shadows.clear();
+            queue.probes.clear();
             let mut alive = vec![true; paths.len()];
             for (i, (path, hit)) in paths.iter_mut().zip(&hits).enumerate() {
-                alive[i] = self.shade(i, path, *hit, &mut segments, &mut shadows);
+                alive[i] = self.shade(i, path, *hit, &mut queue);
             }
             blocked.clear();
-            blocked.resize(segments.len(), false);
-            self.vis.occluded(&segments, &mut blocked)?;
-            rays += segments.len() as u64;
-            for (s, &b) in shadows.iter().zip(&blocked) {
+            blocked.resize(queue.segments.len(), false);
+            self.vis.occluded(&queue.segments, &mut blocked)?;
+            rays += queue.segments.len() as u64;
+            for (s, &b) in queue.shadows.iter().zip(&blocked) {
                 if !b {
                     paths[s.path].radiance += s.contribution;
                 }
             }
+            rays += self.probe(&mut queue.probes, &mut paths, &mut batch, &mut hits)?;
             // Finished paths join their half-image: in an order fixed by the paths themselves
             // (each draws from its own generator), whatever the thread count.
             let mut i = 0;
@@ -357,16 +474,45 @@ impl Tracer<'_> {
         Ok(rays)
     }
 
-    /// Shades a path at its hit: emission, next-event estimation (queued as shadow segments),
-    /// and the next bounce. Returns whether the path goes on.
-    fn shade(
+    /// Runs the probes to their ends, a closest-hit query per leg and per pane crossed, all
+    /// probes' queries batched; adds the contributions of those that reach their light, in
+    /// the probes' order. Returns the rays cast.
+    fn probe(
         &self,
-        index: usize,
-        path: &mut Path,
-        hit: Option<Hit>,
-        segments: &mut Vec<Segment>,
-        shadows: &mut Vec<Shadow>,
-    ) -> bool {
+        probes: &mut [Probe],
+        paths: &mut [Path],
+        batch: &mut Vec<Ray>,
+        hits: &mut Vec<Option<Hit>>,
+    ) -> Result<u64> {
+        let mut rays = 0u64;
+        let mut clear = vec![false; probes.len()];
+        let mut active: Vec<usize> = (0..probes.len()).collect();
+        while !active.is_empty() {
+            batch.clear();
+            batch.extend(active.iter().map(|&i| probes[i].ray));
+            hits.clear();
+            hits.resize(batch.len(), None);
+            self.vis.intersect(batch, hits)?;
+            rays += batch.len() as u64;
+            let mut next = Vec::with_capacity(active.len());
+            for (&i, hit) in active.iter().zip(hits.iter()) {
+                match probes[i].step(self.scene, *hit, self.lift) {
+                    Step::Continue => next.push(i),
+                    Step::Clear => clear[i] = true,
+                    Step::Blocked => {}
+                }
+            }
+            active = next;
+        }
+        for (p, _) in probes.iter().zip(&clear).filter(|(_, &c)| c) {
+            paths[p.path].radiance += p.contribution;
+        }
+        Ok(rays)
+    }
+
+    /// Shades a path at its hit: emission, next-event estimation (queued as shadow segments
+    /// and probes), and the next bounce. Returns whether the path goes on.
+    fn shade(&self, index: usize, path: &mut Path, hit: Option<Hit>, queue: &mut Queue) -> bool {
         let scene = self.scene;
         let Some(hit) = hit else { return false };
         let triangle = &scene.triangles[hit.triangle as usize];
@@ -377,17 +523,19 @@ impl Tracer<'_> {
         let x = path.ray.origin + dir * hit.t;
         let distance = f64::from(hit.t * dir.length());
 
-        // Emission seen: directly, or weighed against the light sampling that could have found it.
+        // Emission seen: directly, or weighed against the light sampling that could have found
+        // it (straight, through thin panes or by planar mirrors: the unfolded distance).
         if front && material.is_emitter() {
             let ke = material.ke.as_dvec3();
             let weight = if path.bounce_pdf > 0.0 {
                 let cos_l = f64::from(-dir.normalize().dot(triangle.normal));
                 let emitter = self.lights.of_triangle[hit.triangle as usize]
                     .map(|e| &self.lights.emitters[e as usize]);
+                let unfolded = path.travelled + distance;
                 match emitter {
                     Some(e) if cos_l > 0.0 => {
                         let light_pdf =
-                            e.probability / f64::from(triangle.area) * distance * distance / cos_l;
+                            e.probability / f64::from(triangle.area) * unfolded * unfolded / cos_l;
                         power_heuristic(path.bounce_pdf, light_pdf)
                     }
                     _ => 1.0,
@@ -396,6 +544,10 @@ impl Tracer<'_> {
                 1.0
             };
             path.radiance += path.throughput * ke * weight;
+        }
+
+        if material.is_specular() {
+            return self.scatter(index, path, hit, distance, queue);
         }
 
         // What this side reflects: fronts with Kd, backs only of two-sided surfaces.
@@ -409,49 +561,16 @@ impl Tracer<'_> {
             -triangle.normal
         };
         let from = x + self.lift * n;
-        let reflect = path.throughput * kd / std::f64::consts::PI;
-
-        // Next events: every point light, and one point on an emitter.
-        for light in self.points {
-            let to = light.position - from;
-            let r2 = f64::from(to.length_squared());
-            let cos = f64::from(n.dot(to.normalize_or_zero()));
-            if cos > 0.0 && r2 > 0.0 {
-                segments.push(Segment {
-                    a: from,
-                    b: light.position,
-                });
-                shadows.push(Shadow {
-                    path: index,
-                    contribution: reflect * light.towards(-to).as_dvec3() * cos / r2,
-                });
-            }
-        }
-        let u: f64 = path.rng.random();
-        let (r1, r2): (f32, f32) = (path.rng.random(), path.rng.random());
-        if let Some(e) = self.lights.pick(u) {
-            let t = &scene.triangles[e.triangle as usize];
-            let s = r1.sqrt();
-            let v = t.vertices;
-            let y = v[0] * (1.0 - s) + v[1] * (s * (1.0 - r2)) + v[2] * (s * r2);
-            let to = y - from;
-            let d2 = f64::from(to.length_squared());
-            let omega = to.normalize_or_zero();
-            let cos_x = f64::from(n.dot(omega));
-            let cos_l = f64::from(-t.normal.dot(omega));
-            if cos_x > 0.0 && cos_l > 0.0 && d2 > 0.0 {
-                let ke = scene.material_of(t.surface).ke.as_dvec3();
-                let area_pdf = e.probability / f64::from(t.area);
-                let light_pdf = area_pdf * d2 / cos_l;
-                let bsdf_pdf = cos_x / std::f64::consts::PI;
-                let weight = power_heuristic(light_pdf, bsdf_pdf);
-                segments.push(Segment { a: from, b: y });
-                shadows.push(Shadow {
-                    path: index,
-                    contribution: reflect * ke * (cos_x * weight / light_pdf),
-                });
-            }
-        }
+        let smooth = Smooth {
+            n,
+            surface: triangle.surface,
+            throughput: path.throughput,
+            reflect: path.throughput * kd / std::f64::consts::PI,
+            lobe: None,
+            p_diffuse: 1.0,
+            p_lobe: 0.0,
+        };
+        self.next_events(index, path, from, &smooth, queue);
 
         // The next bounce: cosine-weighted about the normal, then Russian roulette.
         path.bounces += 1;
@@ -459,27 +578,321 @@ impl Tracer<'_> {
             return false;
         }
         path.throughput *= kd;
-        if path.bounces > 3 {
-            let q = path.throughput.max_element().min(0.95);
-            if path.rng.random::<f64>() >= q {
-                return false;
-            }
-            path.throughput /= q;
+        if !roulette(path) {
+            return false;
         }
-        let (a, b) = n.any_orthonormal_pair();
-        let (u1, u2): (f32, f32) = (path.rng.random(), path.rng.random());
-        let (r, phi) = (u1.sqrt(), u2 * std::f32::consts::TAU);
-        let cos = (1.0 - u1).max(0.0).sqrt();
-        let d = a * (r * phi.cos()) + b * (r * phi.sin()) + n * cos;
+        let (d, cos) = cosine_direction(path, n);
         path.bounce_pdf = f64::from(cos) / std::f64::consts::PI;
-        path.ray = Ray {
-            origin: from,
-            dir: d,
-            t_min: 0.0,
-            t_max: f32::INFINITY,
-        };
+        leave(path, from, d);
         true
     }
+
+    /// Light sampling at a vertex with a non-delta part: every point light and luminaire, one
+    /// point on an emitter (with the weight of multiple importance sampling against drawing
+    /// the direction from `smooth`), and both again through each chain of planar mirrors.
+    /// Draws three numbers from the path's generator.
+    fn next_events(
+        &self,
+        index: usize,
+        path: &mut Path,
+        from: Vec3,
+        smooth: &Smooth,
+        queue: &mut Queue,
+    ) {
+        let scene = self.scene;
+        let n = smooth.n;
+        for light in self.points {
+            let to = light.position - from;
+            let r2 = f64::from(to.length_squared());
+            let cos = f64::from(n.dot(to.normalize_or_zero()));
+            if cos > 0.0 && r2 > 0.0 {
+                let intensity = light.towards(-to).as_dvec3();
+                let contribution = match &smooth.lobe {
+                    None => smooth.reflect * intensity * cos / r2,
+                    Some(_) => smooth.value(to.normalize().as_dvec3(), cos) * intensity / r2,
+                };
+                self.connect(index, from, light.position, contribution, queue);
+            }
+        }
+        let u: f64 = path.rng.random();
+        let (r1, r2): (f32, f32) = (path.rng.random(), path.rng.random());
+        let mut area = None;
+        if let Some(e) = self.lights.pick(u) {
+            let t = &scene.triangles[e.triangle as usize];
+            let s = r1.sqrt();
+            let v = t.vertices;
+            let y = v[0] * (1.0 - s) + v[1] * (s * (1.0 - r2)) + v[2] * (s * r2);
+            let ke = scene.material_of(t.surface).ke.as_dvec3();
+            let area_pdf = e.probability / f64::from(t.area);
+            let to = y - from;
+            let d2 = f64::from(to.length_squared());
+            let omega = to.normalize_or_zero();
+            let cos_x = f64::from(n.dot(omega));
+            let cos_l = f64::from(-t.normal.dot(omega));
+            if cos_x > 0.0 && cos_l > 0.0 && d2 > 0.0 {
+                let light_pdf = area_pdf * d2 / cos_l;
+                let w = omega.as_dvec3();
+                let bsdf_pdf = smooth.pdf(w, cos_x);
+                let weight = power_heuristic(light_pdf, bsdf_pdf);
+                let contribution = match &smooth.lobe {
+                    None => smooth.reflect * ke * (cos_x * weight / light_pdf),
+                    Some(_) => smooth.value(w, cos_x) * ke * (weight / light_pdf),
+                };
+                self.connect(index, from, y, contribution, queue);
+            }
+            area = Some(AreaSample {
+                y,
+                normal: t.normal,
+                ke,
+                area_pdf,
+            });
+        }
+        if self.mirrors.depth() > 0 {
+            self.mirror_events(index, from, smooth, area.as_ref(), queue);
+        }
+    }
+
+    /// The lights' images in chains of planar mirrors, seen from `from`.
+    fn mirror_events(
+        &self,
+        index: usize,
+        from: Vec3,
+        smooth: &Smooth,
+        area: Option<&AreaSample>,
+        queue: &mut Queue,
+    ) {
+        let x = from.as_dvec3();
+        let n = smooth.n.as_dvec3();
+        for chain in self.mirrors.chains() {
+            for light in self.points {
+                let y = light.position.as_dvec3();
+                let Some(u) = self.mirrors.unfold(chain, smooth.surface, x, y) else {
+                    continue;
+                };
+                let cos = n.dot(u.omega);
+                if cos <= 0.0 {
+                    continue;
+                }
+                let intensity = light.towards((u.last - y).as_vec3()).as_dvec3();
+                let contribution =
+                    smooth.value(u.omega, cos) * intensity * u.weight / (u.distance * u.distance);
+                queue
+                    .probes
+                    .push(Probe::new(index, contribution, from, &u.legs[..u.count]));
+            }
+            let Some(a) = area else { continue };
+            let y = a.y.as_dvec3();
+            let Some(u) = self.mirrors.unfold(chain, smooth.surface, x, y) else {
+                continue;
+            };
+            let cos = n.dot(u.omega);
+            let cos_l = a.normal.as_dvec3().dot((u.last - y).normalize_or_zero());
+            if cos <= 0.0 || cos_l <= 0.0 {
+                continue;
+            }
+            let light_pdf = a.area_pdf * u.distance * u.distance / cos_l;
+            let weight = power_heuristic(light_pdf, smooth.pdf(u.omega, cos));
+            let contribution = smooth.value(u.omega, cos) * a.ke * u.weight * (weight / light_pdf);
+            queue
+                .probes
+                .push(Probe::new(index, contribution, from, &u.legs[..u.count]));
+        }
+    }
+
+    /// Queues a shadow connection from `a` to the light point `b`: a segment, or where thin
+    /// panes may stand between, a probe through them.
+    fn connect(&self, index: usize, a: Vec3, b: Vec3, contribution: DVec3, queue: &mut Queue) {
+        if self.mirrors.panes() {
+            queue
+                .probes
+                .push(Probe::new(index, contribution, a, &[Leg::Point(b)]));
+        } else {
+            queue.segments.push(Segment { a, b });
+            queue.shadows.push(Shadow {
+                path: index,
+                contribution,
+            });
+        }
+    }
+
+    /// Shading at a specular material: light sampling for its diffuse part and glossy lobe,
+    /// then the next direction from the diffuse part, the lobe or a delta branch, each chosen
+    /// by the luminance of its weight.
+    fn scatter(
+        &self,
+        index: usize,
+        path: &mut Path,
+        hit: Hit,
+        distance: f64,
+        queue: &mut Queue,
+    ) -> bool {
+        let scene = self.scene;
+        let triangle = &scene.triangles[hit.triangle as usize];
+        let surface = &scene.surfaces[triangle.surface as usize];
+        let material = &scene.materials[surface.material as usize];
+        let dir = path.ray.dir;
+        let front = dir.dot(triangle.normal) < 0.0;
+        let x = path.ray.origin + dir * hit.t;
+        let n = if front {
+            triangle.normal
+        } else {
+            -triangle.normal
+        };
+        let d = dir.as_dvec3().normalize();
+        let kd = if front || surface.two_sided {
+            material.kd.as_dvec3()
+        } else {
+            DVec3::ZERO
+        };
+        let (lobe, delta) =
+            match branches(material, d, triangle.normal.as_dvec3(), surface.two_sided) {
+                Branches::None => (None, [None, None]),
+                Branches::Delta(b) => (None, b),
+                Branches::Glossy(l) => {
+                    debug_assert!(
+                        l.normal().dot(n.as_dvec3()) > 0.999,
+                        "the lobe's side is the hit's"
+                    );
+                    (Some(l), [None, None])
+                }
+            };
+        let ks = match material.kind {
+            Kind::Specular { ks, .. } => ks.as_dvec3(),
+            _ => DVec3::ZERO,
+        };
+        let w_diffuse = luminance(kd);
+        let w_lobe = if lobe.is_some() { luminance(ks) } else { 0.0 };
+        let w_delta = delta.map(|b| b.map_or(0.0, |(_, w)| luminance(w)));
+        let total = w_diffuse + w_lobe + w_delta[0] + w_delta[1];
+        if total <= 0.0 {
+            return false;
+        }
+        let smooth = Smooth {
+            n,
+            surface: triangle.surface,
+            throughput: path.throughput,
+            reflect: path.throughput * kd / std::f64::consts::PI,
+            lobe,
+            p_diffuse: w_diffuse / total,
+            p_lobe: w_lobe / total,
+        };
+        let from = x + self.lift * n;
+        if w_diffuse + w_lobe > 0.0 {
+            self.next_events(index, path, from, &smooth, queue);
+        }
+
+        path.bounces += 1;
+        if path.bounces > self.max_bounces {
+            return false;
+        }
+        let choice = path.rng.random::<f64>() * total;
+        if choice < w_diffuse + w_lobe {
+            // A non-delta direction: from the diffuse part or the lobe, weighed by the mixture.
+            let (w, cos) = if choice < w_diffuse {
+                let (d, _) = cosine_direction(path, n);
+                let w = d.as_dvec3().normalize();
+                (w, w.dot(n.as_dvec3()))
+            } else {
+                let (u1, u2): (f64, f64) = (path.rng.random(), path.rng.random());
+                let Some((w, _)) = smooth.lobe.as_ref().and_then(|l| l.sample(u1, u2)) else {
+                    return false;
+                };
+                (w, w.dot(n.as_dvec3()))
+            };
+            let pdf = smooth.pdf(w, cos);
+            if cos <= 0.0 || pdf <= 0.0 {
+                return false;
+            }
+            path.throughput = smooth.value(w, cos) / pdf;
+            if !roulette(path) {
+                return false;
+            }
+            path.bounce_pdf = pdf;
+            leave(path, from, w.as_vec3());
+            return true;
+        }
+        let i = if choice < w_diffuse + w_lobe + w_delta[0] || w_delta[1] <= 0.0 {
+            0
+        } else {
+            1
+        };
+        let Some((w, weight)) = delta[i] else {
+            return false;
+        };
+        path.throughput *= weight * (total / w_delta[i]);
+        if !roulette(path) {
+            return false;
+        }
+        let thin = matches!(material.kind, Kind::Glass { thin: true, .. });
+        if w.dot(n.as_dvec3()) > 0.0 {
+            // A reflection: light sampling follows planar mirrors and panes, so many in a row.
+            path.crossings = 0;
+            if self.mirrors.is_mirror(triangle.surface) && path.reflections < self.mirrors.depth() {
+                path.reflections += 1;
+                path.travelled += distance;
+            } else {
+                path.bounce_pdf = 0.0;
+            }
+            path.ray = Ray {
+                origin: from,
+                dir: w.as_vec3(),
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            };
+        } else if thin {
+            // Through a pane, unbent: the same ray further on, as shadow rays cross it.
+            path.crossings += 1;
+            if path.crossings > MAX_CROSSINGS {
+                path.bounce_pdf = 0.0;
+            }
+            path.ray.t_min = hit.t + self.lift / dir.length();
+        } else {
+            // Refracted into or out of a solid: light sampling does not follow.
+            path.bounce_pdf = 0.0;
+            path.ray = Ray {
+                origin: x - self.lift * n,
+                dir: w.as_vec3(),
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            };
+        }
+        true
+    }
+}
+
+/// Russian roulette from the fourth bounce: keeps the path with probability q (its
+/// throughput's largest channel, at most 0.95) and divides by it. Returns whether it goes on.
+fn roulette(path: &mut Path) -> bool {
+    if path.bounces > 3 {
+        let q = path.throughput.max_element().min(0.95);
+        if path.rng.random::<f64>() >= q {
+            return false;
+        }
+        path.throughput /= q;
+    }
+    true
+}
+
+/// A cosine-weighted direction about `n`, and its cosine.
+fn cosine_direction(path: &mut Path, n: Vec3) -> (Vec3, f32) {
+    let (a, b) = n.any_orthonormal_pair();
+    let (u1, u2): (f32, f32) = (path.rng.random(), path.rng.random());
+    let (r, phi) = (u1.sqrt(), u2 * std::f32::consts::TAU);
+    let cos = (1.0 - u1).max(0.0).sqrt();
+    (a * (r * phi.cos()) + b * (r * phi.sin()) + n * cos, cos)
+}
+
+/// The path leaves a non-delta vertex at `from` along `dir`.
+fn leave(path: &mut Path, from: Vec3, dir: Vec3) {
+    path.travelled = 0.0;
+    path.reflections = 0;
+    path.crossings = 0;
+    path.ray = Ray {
+        origin: from,
+        dir,
+        t_min: 0.0,
+        t_max: f32::INFINITY,
+    };
 }
 
 /// The power heuristic's weight for a sample from the first density.

@@ -54,7 +54,7 @@ impl Kind {
     pub fn name(self) -> &'static str {
         match self {
             Kind::Diffuse => "diffuse",
-            Kind::Specular { roughness, .. } if roughness == 0.0 => "specular (mirror)",
+            Kind::Specular { roughness: 0.0, .. } => "specular (mirror)",
             Kind::Specular { .. } => "specular (glossy)",
             Kind::Glass { thin: true, .. } => "glass (thin pane)",
             Kind::Glass { .. } => "glass",
