@@ -40,7 +40,7 @@ impl Default for LuxOptions {
     fn default() -> Self {
         LuxOptions {
             light_samples: 64,
-            specular_rays: std::env::var("ML_RAYS").ok().and_then(|v| v.parse().ok()).unwrap_or(256),
+            specular_rays: 256,
             seed: 1,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }

@@ -108,12 +108,6 @@ impl Chains<'_> {
     /// `light`, relative to the light samples' (× their density, for area lights): the
     /// cone's density × highlight samples, over the gather's rays × cos θ/π at the receiver.
     fn third(&self, f: &FirstBounce, light: Vec3) -> f64 {
-        if std::env::var("ML_NO_C").is_ok() {
-            return 0.0;
-        }
-        if std::env::var("ML_ONLY_C").is_ok() {
-            return 1e30;
-        }
         let Some(plane) = self.highlights.plane_of(f.plane) else {
             return 0.0;
         };
@@ -135,7 +129,7 @@ impl Chains<'_> {
         seed: u64,
         samples: &mut Vec<(u32, Vec3, LightSample)>,
     ) -> Result<u64> {
-        if self.highlights.planes.is_empty() || std::env::var("ML_NO_C").is_ok() {
+        if self.highlights.planes.is_empty() {
             return Ok(0);
         }
         let m = highlight_samples(self.rays);
@@ -150,7 +144,10 @@ impl Chains<'_> {
                 if !plane.faces(x) {
                     continue;
                 }
-                let areas = self.lights.area_lights().map(|(i, ..)| Err::<usize, usize>(i));
+                let areas = self
+                    .lights
+                    .area_lights()
+                    .map(|(i, ..)| Err::<usize, usize>(i));
                 let points = (0..self.lights.point_sources().len()).map(Ok);
                 for light in areas.chain(points) {
                     for _ in 0..m {
@@ -221,10 +218,7 @@ impl Chains<'_> {
                     let p_c = f64::from(m) * density / area;
                     let p_a = k * cos_x / pi / area;
                     let p_b = k * cos_x / pi * lobe.pdf(dir) * geometry;
-                    let mut w = crate::specular::lights::power3(p_c, p_a, p_b);
-                    if std::env::var("ML_ONLY_C").is_ok() {
-                        w = 1.0;
-                    }
+                    let w = crate::specular::lights::power3(p_c, p_a, p_b);
                     (to, ke * f * geometry * cos_x * w / p_c)
                 }
                 Ok(j) => {
@@ -330,8 +324,14 @@ impl Chains<'_> {
                         let mis = l.lobe_pdf.map_or(1.0, |pdf| {
                             let dist2 = f64::from(hit.t * hit.t * l.ray.dir.length_squared());
                             let cos_y = -f64::from(dir.dot(tri.normal));
-                            self.lights
-                                .lobe_weight(tri.surface, pdf, dist2, cos_y, 1, 1)
+                            let third = l.first.map_or(0.0, |f| self.third(&f, point));
+                            self.lights.lobe_weight_with(
+                                tri.surface,
+                                pdf,
+                                (dist2, cos_y),
+                                (1, 1),
+                                third,
+                            )
                         });
                         found.direct[l.receiver as usize] +=
                             std::f64::consts::PI * l.weight * material.ke.as_dvec3() * mis;

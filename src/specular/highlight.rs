@@ -133,7 +133,12 @@ mod tests {
         for i in 0..n {
             for j in 0..n {
                 let w = plane
-                    .draw(x, l, (i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64)
+                    .draw(
+                        x,
+                        l,
+                        (i as f64 + 0.5) / n as f64,
+                        (j as f64 + 0.5) / n as f64,
+                    )
                     .unwrap();
                 assert!(w.dot(axis) >= 0.3f64.cos() - 1e-9);
                 inside += usize::from(plane.density(x, l, w) > 0.0);

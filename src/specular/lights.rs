@@ -157,7 +157,13 @@ impl Lights {
         count: u32,
         lobe_samples: u32,
     ) -> f64 {
-        self.lobe_weight_with(surface, pdf_lobe, (dist2, cos_y), (count, lobe_samples), 0.0)
+        self.lobe_weight_with(
+            surface,
+            pdf_lobe,
+            (dist2, cos_y),
+            (count, lobe_samples),
+            0.0,
+        )
     }
 
     /// [`Lights::lobe_weight`] against a third strategy too, whose density is
