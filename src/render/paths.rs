@@ -45,6 +45,9 @@ struct Branch {
     traced: bool,
     /// Whether a glossy bounce came before (later ones draw one direction, not a fan).
     glossed: bool,
+    /// Whether it is its pixel sample's main branch (the heaviest at every delta bounce): the
+    /// side it ends on tells edges apart for supersampling, in mirrors and through glass too.
+    main: bool,
     /// The seed of its random numbers.
     id: u32,
     /// The density the glossy lobe that cast it drew it with, and how many it drew (as many
@@ -84,6 +87,7 @@ impl Shader<'_> {
                 depth: 0,
                 traced: true,
                 glossed: false,
+                main: true,
                 id: first_id.wrapping_add(i as u32),
                 lobe_pdf: None,
             })
@@ -102,8 +106,15 @@ impl Shader<'_> {
                 let dir = b.ray.dir.normalize();
                 let back = dir.dot(tri.normal) > 0.0;
                 let side = side_of(tri.surface, back);
-                if b.depth == 0 {
-                    sides[b.origin] = side;
+                if b.main {
+                    // A side id past the scene's sides stands for a path: which side it met
+                    // at which depth.
+                    sides[b.origin] = if b.depth == 0 {
+                        side
+                    } else {
+                        let n = 2 * self.scene.surfaces.len() as u32;
+                        n.wrapping_mul(b.depth).wrapping_add(side)
+                    };
                 }
                 let point = b.ray.origin + hit.t * b.ray.dir;
                 let material = self.scene.material_of(tri.surface);
@@ -151,6 +162,12 @@ impl Shader<'_> {
                 match branches(material, dir.as_dvec3(), tri.normal.as_dvec3(), two_sided) {
                     Branches::None => {}
                     Branches::Delta(list) => {
+                        let heaviest = list
+                            .iter()
+                            .flatten()
+                            .enumerate()
+                            .max_by(|a, b| a.1 .1.max_element().total_cmp(&b.1 .1.max_element()))
+                            .map_or(0, |(k, _)| k);
                         for (k, (d, w)) in list.iter().flatten().enumerate() {
                             let weight = b.weight * *w;
                             if weight.max_element() < NEGLIGIBLE {
@@ -168,6 +185,7 @@ impl Shader<'_> {
                                 depth: b.depth + 1,
                                 traced: b.traced && b.depth == 0,
                                 glossed: b.glossed,
+                                main: b.main && k == heaviest,
                                 id: side_seed(u64::from(b.id), b.depth, k as u64) as u32,
                                 lobe_pdf: None,
                             });
@@ -247,6 +265,7 @@ impl Shader<'_> {
                 depth: b.depth + 1,
                 traced: false,
                 glossed: true,
+                main: false,
                 id: side_seed(u64::from(b.id), 1000 + j, u64::from(b.depth)) as u32,
                 lobe_pdf: Some((lobe.pdf(d), n)),
             });

@@ -84,7 +84,7 @@ pub const AUTO_SAMPLES: f64 = 4000.0;
 pub const MAX_SPECULAR_RAYS: u32 = 4096;
 
 /// The default [`Options::specular_depth`].
-pub const DEFAULT_SPECULAR_DEPTH: u32 = 3;
+pub const DEFAULT_SPECULAR_DEPTH: u32 = 8;
 
 /// The default [`Options::cluster_threshold`].
 pub const DEFAULT_CLUSTER_THRESHOLD: f64 = 0.05;

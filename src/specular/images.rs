@@ -10,7 +10,7 @@ use super::{Reflector, Specular};
 
 /// Chains of images carrying less than this share of a light (at normal incidence) are left
 /// out: a pane's reflection of a pane's reflection (0.6%), say.
-pub(crate) const IMAGE_CUTOFF: f64 = 0.002;
+pub(crate) const IMAGE_CUTOFF: f64 = 0.01;
 
 /// A chain of reflectors a light is seen through: indices into `Specular::reflectors`, the
 /// one nearest the receiver first.

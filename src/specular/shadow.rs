@@ -2,9 +2,11 @@
 //! share of the light arrives along each. A path follows the straight line to the light's image;
 //! it must pass each reflector of its chain inside the reflector's outline (a window), on a
 //! reflecting side, then go on to the next image, and finally reach the light. Glass it crosses
-//! on the way passes light with its Fresnel transmittance (straight through: exact for thin
-//! panes, and for a slab's parallel faces up to the sideways shift of the ray, whose internal
-//! bounces are summed: T_in T_out / (1 − R_in R_out)); anything else blocks it.
+//! on the way passes light with its Fresnel transmittance (straight through, each face taken at
+//! the angle the line meets it from the air: exact for thin panes, and for a slab's parallel
+//! faces up to the sideways shift of the ray, whose internal bounces are summed:
+//! T_in T_out / (1 − R_in R_out)); anything else blocks it. What a solid's refraction focuses
+//! or spreads (caustics) is not modelled this way; the chains follow true refraction.
 
 use glam::{DVec3, Vec3};
 
@@ -120,7 +122,11 @@ pub(crate) fn arriving(
                             w.entered = Some(r);
                             1.0 - r
                         } else {
-                            let r = fresnel::reflectance(cos, 1.0 / ior);
+                            // Leaving, at the angle the straight line has in air on this side:
+                            // refracted, light leaves at the angle it entered at, so the Fresnel
+                            // factor is taken from outside (no total internal reflection that a
+                            // bent ray would not have).
+                            let r = fresnel::reflectance(cos, ior);
                             let bounces =
                                 w.entered.take().map_or(1.0, |r_in| 1.0 / (1.0 - r_in * r));
                             (1.0 - r) * bounces
