@@ -65,12 +65,6 @@ impl Lobe {
     pub(crate) fn normal(&self) -> DVec3 {
         self.n
     }
-
-    /// The lobe weighted by `w` (a path's throughput reaching it).
-    pub(crate) fn scaled(mut self, w: DVec3) -> Lobe {
-        self.ks *= w;
-        self
-    }
 }
 
 /// Mirror reflection of travelling direction `d` about the unit normal `n`.

@@ -29,7 +29,6 @@ pub(crate) struct Site {
 
 /// What interpolation reads of a solution.
 pub(crate) struct Interpolator<'a> {
-    scene: &'a Scene,
     solution: &'a Solution,
     vis: &'a dyn Visibility,
     lift: f32,
@@ -45,7 +44,6 @@ impl<'a> Interpolator<'a> {
             support[side as usize] = support[side as usize].max(SUPPORT * d);
         }
         Interpolator {
-            scene,
             solution,
             vis,
             lift: crate::visibility::lift(scene),
@@ -178,10 +176,5 @@ impl<'a> Interpolator<'a> {
             }
         }
         Ok((None, queries))
-    }
-
-    /// The scene it interpolates in.
-    pub(crate) fn scene(&self) -> &Scene {
-        self.scene
     }
 }

@@ -360,7 +360,6 @@ fn camera_ray(scene: &Scene, x: f32, y: f32) -> Ray {
 /// Radiance at ray hits.
 struct Shader<'a> {
     scene: &'a Scene,
-    solution: &'a Solution,
     vis: &'a dyn Visibility,
     interpolator: Interpolator<'a>,
     /// What the pixels hold.
@@ -431,7 +430,6 @@ impl<'a> Shader<'a> {
         let full = (0..s.len()).map(|k| shown(k, glam::DVec3::ZERO)).collect();
         Shader {
             scene,
-            solution,
             vis,
             interpolator: Interpolator::new(scene, solution, vis),
             quantity: options.quantity,

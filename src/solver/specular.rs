@@ -194,11 +194,6 @@ impl Transfer {
             .map(|&(i, w)| (i as usize, rgb(w)))
     }
 
-    /// Entries of G.
-    pub(crate) fn len(&self) -> usize {
-        self.entries.len()
-    }
-
     /// Bytes held.
     pub(crate) fn bytes(&self) -> usize {
         use crate::sampling::vec_bytes;

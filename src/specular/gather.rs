@@ -25,6 +25,10 @@ use crate::sampling::{side_of, Side};
 use crate::scene::Scene;
 use crate::visibility::{Ray, Visibility};
 
+/// A highlight sample drawn: (receiver, plane, light: area index `Err` or point index `Ok`,
+/// light point, ray).
+type Drawn = (u32, usize, Result<usize, usize>, Vec3, Ray);
+
 /// The golden ratio's fractional part: the Fibonacci lattice's second coordinate.
 const GOLDEN: f64 = 0.618_033_988_749_894_8;
 
@@ -135,8 +139,7 @@ impl Chains<'_> {
         let m = highlight_samples(self.rays);
         let k = f64::from(self.rays.max(1));
         let pi = std::f64::consts::PI;
-        // (receiver, plane, light: area index or point index, light point, ray)
-        let mut drawn: Vec<(u32, usize, Result<usize, usize>, Vec3, Ray)> = Vec::new();
+        let mut drawn: Vec<Drawn> = Vec::new();
         for (r, &(x, n, id)) in receivers.iter().enumerate() {
             let from = x + self.lift * n;
             let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 41));

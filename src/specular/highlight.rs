@@ -19,8 +19,7 @@ pub(crate) struct Plane {
     pub surface: u32,
     /// The plane, as a reflector (for the images).
     pub reflector: Reflector,
-    /// The cone's half-angle and 1 − its cosine.
-    pub half_angle: f64,
+    /// 1 − the cosine of the cone's half-angle.
     one_minus_cos: f64,
 }
 
@@ -54,7 +53,6 @@ impl Highlights {
                             reflects: Reflects::Mirror(ks),
                             both_sides: surface.two_sided,
                         },
-                        half_angle,
                         one_minus_cos: 1.0 - half_angle.cos(),
                     });
                 }
@@ -122,7 +120,6 @@ mod tests {
                 reflects: Reflects::Mirror(Vec3::ONE),
                 both_sides: false,
             },
-            half_angle: 0.3,
             one_minus_cos: 1.0 - 0.3f64.cos(),
         };
         let (x, l) = (Vec3::new(0.0, 1.0, 0.0), Vec3::new(2.0, 1.0, 0.0));
