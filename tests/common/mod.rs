@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod counting;
+pub mod mirror;
 
 use std::path::PathBuf;
 
