@@ -189,7 +189,7 @@ pub struct SweepArgs {
     /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
     /// Keys: preset, epsilon, zeta, alpha, rounds, light-samples, tolerance, max-shots,
     /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
-    /// supersample, direct-rays, patch-size, spp.
+    /// supersample, direct-rays, specular-depth, specular-rays, glossy-rays, patch-size, spp.
     #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
     pub vary: Vec<(String, Vec<String>)>,
     /// How each run computes its image.
@@ -299,6 +299,11 @@ pub enum Command {
         #[arg(long, default_value_t = 64,
               value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
         grid_light_samples: u32,
+        /// Chains followed from each grid point through mirrors, glossy surfaces and glass
+        /// (scenes with specular materials only).
+        #[arg(long, default_value_t = meshlight::lux::LuxOptions::default().specular_rays,
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::solver::MAX_SPECULAR_RAYS)))]
+        grid_specular_rays: u32,
     },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
     Samples {

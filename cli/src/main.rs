@@ -64,6 +64,7 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
             solve,
             output,
             grid_light_samples,
+            grid_specular_rays,
         } => {
             let (scene, options) = solve_setup(&solve, loading)?;
             let vis = backend_from(&solve.knobs).build(&scene)?;
@@ -71,9 +72,9 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
             print!("{}", solve_summary(&scene, &solution, &options, vis.name()));
             let lux = meshlight::lux::LuxOptions {
                 light_samples: grid_light_samples.max(1),
+                specular_rays: grid_specular_rays,
                 seed: options.seed,
                 threads: options.threads,
-                ..Default::default()
             };
             lux::run(&scene, &solution, vis.as_ref(), &lux, &output)
         }

@@ -35,6 +35,9 @@ const KEYS: &[&str] = &[
     "seed",
     "supersample",
     "direct-rays",
+    "specular-depth",
+    "specular-rays",
+    "glossy-rays",
     "patch-size",
     "spp",
 ];
@@ -142,6 +145,8 @@ struct Extra {
     supersample: u32,
     /// Shadow rays per area light at each camera hit (0: direct light interpolated).
     direct_rays: u32,
+    /// Rays drawn from a glossy lobe where a camera path meets one.
+    glossy_rays: u32,
     patch_size: Option<f32>,
     spp: u32,
     /// Errors on averages over blocks of this many pixels a side.
@@ -176,6 +181,9 @@ fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
         "seed" => o.seed = value(key, v)?,
         "supersample" => extra.supersample = value::<u32>(key, v)?.max(1),
         "direct-rays" => extra.direct_rays = value(key, v)?,
+        "specular-depth" => o.specular_depth = value(key, v)?,
+        "specular-rays" => o.specular_rays = value(key, v)?,
+        "glossy-rays" => extra.glossy_rays = value(key, v)?,
         "patch-size" => extra.patch_size = Some(value(key, v)?),
         "spp" => extra.spp = value(key, v)?,
         other => bail!("--vary: unknown setting '{other}'"),
@@ -253,6 +261,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
         let mut extra = Extra {
             supersample: sweep.supersample.max(1),
             direct_rays: sweep.direct_rays,
+            glossy_rays: meshlight::RenderOptions::default().glossy_rays,
             patch_size: sweep.patch_size,
             spp: sweep.spp,
             block: sweep.block,
@@ -320,6 +329,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             let extra = Extra {
                 supersample: 1,
                 direct_rays: 0,
+                glossy_rays: 0,
                 patch_size: None,
                 spp,
                 block: sweep.block,
@@ -433,6 +443,7 @@ fn measure(
                         threads: options.threads,
                         supersample: extra.supersample,
                         direct: meshlight::Direct::from_rays(extra.direct_rays),
+                        glossy_rays: extra.glossy_rays,
                         ..meshlight::RenderOptions::default()
                     },
                     progress,
