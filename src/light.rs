@@ -457,11 +457,14 @@ impl DirectLight {
             }
             let weight = f64::from(cos_x * cos_y / (dist2 * dist2));
             weights[slot].0 += weight;
-            paths.push(LightPath {
-                from,
-                to: y + self.lift * emitter.normal,
-                chain,
-            });
+            let to = y + self.lift * emitter.normal;
+            if let (Some(&k), Some((spec, _))) = (chain.first(), &self.specular) {
+                if !spec.reflectors[k as usize].may_pass(from, to) {
+                    // Misses the window: it counts, and brings nothing, without a path.
+                    continue;
+                }
+            }
+            paths.push(LightPath { from, to, chain });
             rays.push((slot, weight));
         }
     }

@@ -52,6 +52,7 @@ impl Highlights {
                             offset: surface.offset,
                             reflects: Reflects::Mirror(ks),
                             both_sides: surface.two_sided,
+                            bounds: super::window_bounds(scene, surface),
                         },
                         one_minus_cos: 1.0 - half_angle.cos(),
                     });
@@ -119,6 +120,7 @@ mod tests {
                 offset: 0.0,
                 reflects: Reflects::Mirror(Vec3::ONE),
                 both_sides: false,
+                bounds: crate::specular::EVERYWHERE,
             },
             one_minus_cos: 1.0 - 0.3f64.cos(),
         };

@@ -97,6 +97,7 @@ mod tests {
             offset,
             reflects: Reflects::Mirror(Vec3::splat(ks)),
             both_sides: false,
+            bounds: crate::specular::EVERYWHERE,
         }
     }
 

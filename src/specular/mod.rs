@@ -61,6 +61,47 @@ pub(crate) struct Reflector {
     pub reflects: Reflects,
     /// Whether its back reflects too.
     pub both_sides: bool,
+    /// Its triangles' bounding box, widened a little: a line that crosses the plane outside it
+    /// cannot pass the window.
+    pub bounds: (Vec3, Vec3),
+}
+
+/// A surface's bounding box, widened for the rounding of a crossing point and of the lifts.
+pub(crate) fn window_bounds(scene: &Scene, surface: &crate::scene::Surface) -> (Vec3, Vec3) {
+    let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+    let range = surface.triangles.start as usize..surface.triangles.end as usize;
+    for t in &scene.triangles[range] {
+        for v in t.vertices {
+            (lo, hi) = (lo.min(v), hi.max(v));
+        }
+    }
+    let pad = Vec3::splat(1e-3 * (hi - lo).length() + 1e-3);
+    (lo - pad, hi + pad)
+}
+
+/// Bounds that turn nothing away.
+#[cfg(test)]
+pub(crate) const EVERYWHERE: (Vec3, Vec3) = (Vec3::splat(f32::MIN), Vec3::splat(f32::MAX));
+
+impl Reflector {
+    /// Whether the straight segment `from` → `to` can pass through this reflector's outline:
+    /// false only when it crosses the plane outside the bounding box (or not at all). Exact
+    /// as a filter: a segment it turns away would have missed the surface.
+    pub(crate) fn may_pass(&self, from: Vec3, to: Vec3) -> bool {
+        let (a, b) = (
+            self.normal.dot(from) - self.offset,
+            self.normal.dot(to) - self.offset,
+        );
+        if a * b > 0.0 {
+            return false;
+        }
+        if a == b {
+            return true;
+        }
+        let p = from + (to - from) * (a / (a - b));
+        let (lo, hi) = self.bounds;
+        p.cmpge(lo).all() && p.cmple(hi).all()
+    }
 }
 
 /// What a scene's specular surfaces are.
@@ -118,6 +159,7 @@ impl Specular {
             if let Some(reflects) = reflects {
                 let pane = matches!(reflects, Reflects::Pane(_));
                 s.reflectors.push(Reflector {
+                    bounds: window_bounds(scene, surface),
                     surface: i as u32,
                     normal: surface.normal,
                     offset: surface.offset,
@@ -132,5 +174,31 @@ impl Specular {
     /// Whether the scene has anything specular at all.
     pub(crate) fn any(&self) -> bool {
         self.specular.iter().any(|&s| s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_segment_passes_a_window_only_where_it_crosses_the_plane_inside_it() {
+        // A 1 × 1 window in the plane y = 0, facing up.
+        let r = Reflector {
+            surface: 0,
+            normal: Vec3::Y,
+            offset: 0.0,
+            reflects: Reflects::Mirror(Vec3::ONE),
+            both_sides: false,
+            bounds: (Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0)),
+        };
+        let v = Vec3::new;
+        // Straight down through its middle; slanted, crossing at (0.75, 0, 0.5).
+        assert!(r.may_pass(v(0.5, 1.0, 0.5), v(0.5, -1.0, 0.5)));
+        assert!(r.may_pass(v(0.5, 1.0, 0.5), v(1.0, -1.0, 0.5)));
+        // Slanted more, crossing at (1.5, 0, 0.5): outside.
+        assert!(!r.may_pass(v(0.5, 1.0, 0.5), v(2.5, -1.0, 0.5)));
+        // Both ends above the plane: it never crosses.
+        assert!(!r.may_pass(v(0.5, 1.0, 0.5), v(0.5, 0.5, 0.5)));
     }
 }

@@ -67,7 +67,18 @@ pub(crate) fn arriving(
         })
         .collect();
     let mut queries = 0u64;
-    let mut active: Vec<usize> = (0..paths.len()).collect();
+    // A path whose line to the image crosses the first window's plane outside the window
+    // arrives with nothing; most do, in a room of small panes, and cost no ray.
+    let mut active: Vec<usize> = Vec::with_capacity(paths.len());
+    for (i, p) in paths.iter().enumerate() {
+        match p.chain.first() {
+            Some(&k) if !spec.reflectors[k as usize].may_pass(p.from, p.to) => {
+                walks[i].share = DVec3::ZERO;
+                walks[i].done = true;
+            }
+            _ => active.push(i),
+        }
+    }
     let mut rays = Vec::new();
     let mut hits = Vec::new();
     while !active.is_empty() {
