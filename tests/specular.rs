@@ -447,8 +447,8 @@ fn specular_scenes_give_the_same_numbers_on_one_thread_and_two() {
         let scene = shipped_at(name, 24);
         let vis = meshlight::Backend::default_backend().build(&scene).unwrap();
         let floor = Grid::new(
-            "floor",
-            Vec3::new(0.5, 0.8, 0.5),
+            "above the boxes",
+            Vec3::new(0.5, 2.0, 0.5),
             Vec3::new(3.0, 0.0, 0.0),
             Vec3::new(0.0, 0.0, 3.0),
             Some(Vec3::Y),
