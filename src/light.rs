@@ -363,6 +363,12 @@ impl DirectLight {
                     _ => (&self.emitters, STRAIGHT),
                 };
                 for (e, emitter) in emitters.iter().enumerate() {
+                    if let (Some(&k), Some((spec, _))) = (chain.first(), &self.specular) {
+                        if !spec.reflectors[k as usize].may_show(from, &emitter.triangles) {
+                            // No line to the image passes the window: it brings nothing.
+                            continue;
+                        }
+                    }
                     let slot = (r * ways + w) * ne + e;
                     self.emitter_rays(
                         emitter,

@@ -483,7 +483,10 @@ fn specular_scenes_give_the_same_numbers_on_one_thread_and_two() {
         };
         let (one, two) = (run(1), run(2));
         assert!(one.0.iter().any(|b| b.x > 0.0), "{name}: dark");
-        assert!(one.2.iter().all(|e| e.y > 0.0), "{name}: a grid point in the dark");
+        assert!(
+            one.2.iter().all(|e| e.y > 0.0),
+            "{name}: a grid point in the dark"
+        );
         assert!(one == two, "{name}: 1 and 2 threads differ");
     }
 }

@@ -102,6 +102,28 @@ impl Reflector {
         let (lo, hi) = self.bounds;
         p.cmpge(lo).all() && p.cmple(hi).all()
     }
+
+    /// Whether any line from `from` to a point of `triangles` (a light's image behind this
+    /// reflector) may pass its window: false only when every such line crosses the plane
+    /// outside the bounding box. Seen from `from`, the triangles project onto the plane inside
+    /// the box of their vertices' projections, so that box is compared, widened by a margin
+    /// for the shadow rays' lifted ends.
+    pub(crate) fn may_show(&self, from: Vec3, triangles: &[[Vec3; 3]]) -> bool {
+        let a = self.normal.dot(from) - self.offset;
+        let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+        for &v in triangles.iter().flatten() {
+            let b = self.normal.dot(v) - self.offset;
+            if a * b >= 0.0 || a == b {
+                // A vertex on the near side: the projection is unbounded.
+                return true;
+            }
+            let p = from + (v - from) * (a / (a - b));
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+        let margin = Vec3::splat(1e-3 * (1.0 + (hi - lo).length()));
+        let (wlo, whi) = self.bounds;
+        (lo - margin).cmple(whi).all() && (hi + margin).cmpge(wlo).all()
+    }
 }
 
 /// What a scene's specular surfaces are.
@@ -200,5 +222,15 @@ mod tests {
         assert!(!r.may_pass(v(0.5, 1.0, 0.5), v(2.5, -1.0, 0.5)));
         // Both ends above the plane: it never crosses.
         assert!(!r.may_pass(v(0.5, 1.0, 0.5), v(0.5, 0.5, 0.5)));
+        // An image triangle 1 below the plane seen from 1 above: it projects halfway, so one
+        // at x ∈ [2, 3] shows through [1, 1.5] (touching the window's edge) and one at
+        // x ∈ [3, 4] through [1.5, 2] (outside); one reaching above the plane always may.
+        let from = v(0.0, 1.0, 0.5);
+        let near = [[v(2.0, -1.0, 0.5), v(3.0, -1.0, 0.5), v(2.5, -1.0, 0.6)]];
+        let far = [[v(3.0, -1.0, 0.5), v(4.0, -1.0, 0.5), v(3.5, -1.0, 0.6)]];
+        let through = [[v(3.0, -1.0, 0.5), v(4.0, 0.5, 0.5), v(3.5, -1.0, 0.6)]];
+        assert!(r.may_show(from, &near));
+        assert!(!r.may_show(from, &far));
+        assert!(r.may_show(from, &through));
     }
 }
