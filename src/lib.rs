@@ -47,6 +47,7 @@
 
 mod area;
 pub mod budget;
+pub mod diagnose;
 pub mod error;
 pub mod ies;
 mod light;

@@ -68,6 +68,7 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
         } => {
             let (scene, options) = solve_setup(&solve, loading)?;
             let vis = backend_from(&solve.knobs).build(&scene)?;
+            diagnose(&scene, vis.as_ref())?;
             let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
             print!("{}", solve_summary(&scene, &solution, &options, vis.name()));
             let lux = meshlight::lux::LuxOptions {
@@ -106,6 +107,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
     }
     let (scene, options) = solve_setup(&r.solve, loading)?;
     let vis = backend_from(&r.solve.knobs).build(&scene)?;
+    diagnose(&scene, vis.as_ref())?;
     // The image and what to say about how it was made, by each method.
     let (image, summary) = match r.method {
         Method::Pathtrace => {
@@ -143,6 +145,9 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
             (image, summary)
         }
     };
+    if let Some(finding) = meshlight::diagnose::image(&scene, &image) {
+        eprintln!("meshlight: warning: {}", finding.message);
+    }
     image.write_exr(&r.output)?;
     let png = r.output.with_extension("png");
     match r.false_color {
@@ -234,6 +239,7 @@ fn compare(
 fn samples(solve: &SolveArgs, output: &Path, loading: &LoadOptions) -> anyhow::Result<()> {
     let (scene, options) = solve_setup(solve, loading)?;
     let vis = backend_from(&solve.knobs).build(&scene)?;
+    diagnose(&scene, vis.as_ref())?;
     let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
     let radiosity = solution.radiosity();
     let mean = radiosity.iter().map(|b| b.element_sum() / 3.0).sum::<f64>()
@@ -271,6 +277,18 @@ fn bench_vis(b: BenchArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         eprintln!("  {step}...");
     })?;
     print!("{}", bench_report(&scene, &report));
+    Ok(())
+}
+
+/// What would make the result black or wrong without an error: warnings on stderr, and an
+/// error where nothing emits light.
+fn diagnose(scene: &Scene, vis: &dyn meshlight::Visibility) -> anyhow::Result<()> {
+    for finding in meshlight::diagnose::before_solve(scene, vis)? {
+        if finding.fatal {
+            anyhow::bail!("{}: {}", scene.path().display(), finding.message);
+        }
+        eprintln!("meshlight: warning: {}", finding.message);
+    }
     Ok(())
 }
 

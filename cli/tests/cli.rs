@@ -488,3 +488,63 @@ fn false_colour_renders_hold_the_illuminance_and_refuse_bad_ranges() {
         assert!(text(&out.stderr).contains(problem), "{}", text(&out.stderr));
     }
 }
+
+#[test]
+fn a_scene_without_light_is_refused_and_a_light_facing_the_ceiling_is_named() {
+    // The Cornell room as Blender's OBJ exporter leaves it when the light is a plain Emission
+    // node (Ke 0), and again with its light panel turned to face the ceiling 1 cm above.
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = root("scenes/cornell");
+    for file in ["cornell.obj", "cornell.mtl"] {
+        std::fs::copy(cornell.join(file), dir.path().join(file)).unwrap();
+    }
+    let scene = std::fs::read_to_string(cornell.join("scene.toml")).unwrap();
+    let dark = dir.path().join("dark.toml");
+    std::fs::write(
+        &dark,
+        format!("{scene}\n[material.light]\nke = [0.0, 0.0, 0.0]\n"),
+    )
+    .unwrap();
+    let out = meshlight(&["render", dark.to_str().unwrap(), "-o", "/dev/null"]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("dark.toml: nothing in the scene emits light") && stderr.contains("Ke 0"),
+        "{stderr}"
+    );
+    // The light's face turned up: its vertex order reversed in the OBJ.
+    let obj = std::fs::read_to_string(dir.path().join("cornell.obj")).unwrap();
+    let mut flipped = String::new();
+    let mut light = false;
+    for line in obj.lines() {
+        if line.starts_with("usemtl") {
+            light = line.trim() == "usemtl light";
+        }
+        if light && line.starts_with("f ") {
+            let mut v: Vec<&str> = line.split_whitespace().skip(1).collect();
+            v.reverse();
+            flipped.push_str(&format!("f {}\n", v.join(" ")));
+        } else {
+            flipped.push_str(line);
+            flipped.push('\n');
+        }
+    }
+    std::fs::write(dir.path().join("cornell.obj"), flipped).unwrap();
+    let up = dir.path().join("up.toml");
+    std::fs::write(&up, &scene).unwrap();
+    let exr = dir.path().join("up.exr");
+    let out = meshlight(&[
+        "render",
+        up.to_str().unwrap(),
+        "--preset",
+        "preview",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("warning: the area light") && stderr.contains("material 'light'"),
+        "{stderr}"
+    );
+}

@@ -1,0 +1,353 @@
+//! What makes a scene's image black or wrong without any error: no light at all, light that
+//! leaves the scene or falls on the backs of one-sided faces, an area light facing away from
+//! everything, a camera outside the scene or looking at backs. Each check casts a few thousand
+//! rays, far fewer than a solve, and reports in words that name what to fix; the library never
+//! prints, so a host (or the CLI) decides what to do with the findings.
+
+use glam::Vec3;
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use crate::error::Result;
+use crate::scene::Scene;
+use crate::visibility::{Hit, Ray, Visibility};
+
+/// Rays cast from each light.
+const LIGHT_RAYS: usize = 1024;
+/// Camera rays cast, a side.
+const CAMERA_GRID: u32 = 32;
+/// The share of light or view that must go astray before a warning.
+const MOST: f64 = 0.5;
+/// An area light whose rays meet a surface within this share of the scene's diagonal, for
+/// half of them or more, faces something close by.
+const CLOSE: f32 = 0.02;
+/// An area light whose front meets the scene with fewer of its rays than this faces away.
+const SEES_NOTHING: f64 = 0.05;
+
+/// One thing found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Finding {
+    /// Whether the scene cannot give a meaningful result at all (nothing emits light).
+    pub fatal: bool,
+    /// What was found and what to do, in one or two sentences.
+    pub message: String,
+}
+
+/// Where a ray from a light or the camera first lands.
+#[derive(Clone, Copy, PartialEq)]
+enum Landing {
+    /// Nothing: it leaves the scene.
+    Away,
+    /// The back of a one-sided face (which absorbs it unseen), with the surface.
+    Back(u32),
+    /// A side that reflects or emits.
+    Front,
+}
+
+fn landing(scene: &Scene, ray: &Ray, hit: Option<Hit>) -> Landing {
+    let Some(hit) = hit else {
+        return Landing::Away;
+    };
+    let t = &scene.triangles()[hit.triangle as usize];
+    let surface = &scene.surfaces()[t.surface as usize];
+    let two_sided = surface.two_sided || scene.materials()[surface.material as usize].two_sided;
+    if ray.dir.dot(t.normal) > 0.0 && !two_sided {
+        Landing::Back(t.surface)
+    } else {
+        Landing::Front
+    }
+}
+
+/// A material's name for messages: the surface's material, and the surface's index.
+fn surface_name(scene: &Scene, surface: u32) -> String {
+    let m = scene.surfaces()[surface as usize].material as usize;
+    format!(
+        "surface {surface} (material '{}')",
+        scene.materials()[m].name
+    )
+}
+
+/// A unit direction, cosine-distributed about `n`.
+fn cosine_direction(n: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
+    let (u1, u2): (f32, f32) = (rng.random(), rng.random());
+    let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+    let (t, b) = n.any_orthonormal_pair();
+    (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
+}
+
+/// A unit direction, uniform over the sphere.
+fn sphere_direction(rng: &mut Pcg64Mcg) -> Vec3 {
+    let (u1, u2): (f32, f32) = (rng.random(), rng.random());
+    let z = 1.0 - 2.0 * u1;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * u2;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// The checks that need no solve: a scene with no light (fatal), lights whose power mostly
+/// leaves the scene or falls on backs, an area light whose front sees nothing, a camera
+/// outside the scene or looking mostly at backs or into the void. Deterministic.
+pub fn before_solve(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
+    let mut found = Vec::new();
+    if scene.emitted_power().max_element() <= 0.0 {
+        found.push(Finding {
+            fatal: true,
+            message: "nothing in the scene emits light: no material has a non-zero Ke, and \
+                      there is no point light or luminaire. (Blender's OBJ exporter writes Ke 0 \
+                      for a plain Emission node: set the light's material Ke in the MTL, or a \
+                      [material.NAME] ke in the scene file, or add a [[point_light]].)"
+                .into(),
+        });
+        return Ok(found);
+    }
+    found.extend(lights(scene, vis)?);
+    found.extend(camera(scene, vis)?);
+    Ok(found)
+}
+
+/// Where each light's rays land: the power-weighted shares away and on backs, per-surface
+/// back shares, and the area lights that see nothing.
+fn lights(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
+    let lift = crate::visibility::lift(scene);
+    let diagonal = scene.bounds().diagonal();
+    let mut rng = Pcg64Mcg::seed_from_u64(0x5EED_D1A6);
+    // Per light: its power (brightest channel), rays, and for area lights the surface.
+    let mut found = Vec::new();
+    let (mut away, mut back, mut total) = (0.0f64, 0.0f64, 0.0f64);
+    let mut backs: Vec<f64> = vec![0.0; scene.surfaces().len()];
+    let mut cast = |rays: Vec<Ray>, power: f64, emitter: Option<u32>| -> Result<()> {
+        let mut hits = vec![None; rays.len()];
+        vis.intersect(&rays, &mut hits)?;
+        let each = power / rays.len().max(1) as f64;
+        let mut met = 0usize;
+        let mut distances: Vec<f32> = hits.iter().flatten().map(|h| h.t).collect();
+        for (ray, hit) in rays.iter().zip(hits) {
+            match landing(scene, ray, hit) {
+                Landing::Away => away += each,
+                Landing::Back(s) => {
+                    back += each;
+                    backs[s as usize] += each;
+                    met += 1;
+                }
+                Landing::Front => met += 1,
+            }
+        }
+        total += power;
+        if let Some(s) = emitter {
+            if (met as f64) < SEES_NOTHING * rays.len() as f64 {
+                found.push(Finding {
+                    fatal: false,
+                    message: format!(
+                        "the area light {} faces away from the scene: its front sees nothing \
+                         ({met} of {} rays from it met a surface). Flip its normals, or set \
+                         two_sided = true on its material.",
+                        surface_name(scene, s),
+                        rays.len()
+                    ),
+                });
+            } else {
+                distances.sort_by(f32::total_cmp);
+                let median = distances[distances.len() / 2];
+                if median < CLOSE * diagonal {
+                    found.push(Finding {
+                        fatal: false,
+                        message: format!(
+                            "the area light {} faces a surface {median:.3} away over most of its                              front: its light is trapped there (a light panel facing the                              ceiling? Blender's lights emit from both sides). Flip its normals,                              or set two_sided = true on its material.",
+                            surface_name(scene, s)
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
+    };
+    for (s, power) in scene.emitters() {
+        let surface = &scene.surfaces()[s as usize];
+        let triangles =
+            &scene.triangles()[surface.triangles.start as usize..surface.triangles.end as usize];
+        let area: f32 = triangles.iter().map(|t| t.area).sum();
+        if area <= 0.0 {
+            continue;
+        }
+        let rays: Vec<Ray> = (0..LIGHT_RAYS)
+            .map(|_| {
+                let mut u = rng.random::<f32>() * area;
+                let t = triangles
+                    .iter()
+                    .find(|t| {
+                        u -= t.area;
+                        u <= 0.0
+                    })
+                    .unwrap_or(&triangles[triangles.len() - 1]);
+                let (a, b): (f32, f32) = (rng.random(), rng.random());
+                let (a, b) = if a + b > 1.0 {
+                    (1.0 - a, 1.0 - b)
+                } else {
+                    (a, b)
+                };
+                let [p, q, r] = t.vertices;
+                let x = p + (q - p) * a + (r - p) * b;
+                Ray {
+                    origin: x + lift * t.normal,
+                    dir: cosine_direction(t.normal, &mut rng),
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                }
+            })
+            .collect();
+        cast(rays, power.max_element(), Some(s))?;
+    }
+    for source in scene.point_sources() {
+        let dirs: Vec<Vec3> = (0..LIGHT_RAYS)
+            .map(|_| sphere_direction(&mut rng))
+            .collect();
+        let weights: Vec<f64> = dirs
+            .iter()
+            .map(|&d| f64::from(source.towards(d).max_element()))
+            .collect();
+        let sum: f64 = weights.iter().sum();
+        if sum <= 0.0 {
+            continue;
+        }
+        // Rays weighed by the intensity towards them: cast each direction with its share.
+        let power = sum / LIGHT_RAYS as f64 * 4.0 * std::f64::consts::PI;
+        let rays: Vec<Ray> = dirs
+            .iter()
+            .map(|&dir| Ray {
+                origin: source.position,
+                dir,
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            })
+            .collect();
+        let mut hits = vec![None; rays.len()];
+        vis.intersect(&rays, &mut hits)?;
+        for ((ray, hit), w) in rays.iter().zip(hits).zip(&weights) {
+            let each = power * w / sum;
+            match landing(scene, ray, hit) {
+                Landing::Away => away += each,
+                Landing::Back(s) => {
+                    back += each;
+                    backs[s as usize] += each;
+                }
+                Landing::Front => {}
+            }
+        }
+        total += power;
+    }
+    if total > 0.0 && (away + back) / total > MOST {
+        let mut worst: Vec<(usize, f64)> = backs
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|&(_, b)| b > 0.0)
+            .collect();
+        worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let named: Vec<String> = worst
+            .iter()
+            .take(4)
+            .map(|&(s, b)| {
+                format!(
+                    "{} ({:.0}%)",
+                    surface_name(scene, s as u32),
+                    100.0 * b / total
+                )
+            })
+            .collect();
+        let mut message = format!(
+            "most of the light goes astray: {:.0}% of the emitted power leaves the scene and \
+             {:.0}% falls on the backs of one-sided faces, which absorb it unseen.",
+            100.0 * away / total,
+            100.0 * back / total
+        );
+        if !named.is_empty() {
+            message.push_str(&format!(
+                " Facing away from the lights: {}. Flip their normals, or set two_sided = true \
+                 in the scene file.",
+                named.join(", ")
+            ));
+        } else {
+            message.push_str(" Is the scene open, or are the lights outside it?");
+        }
+        found.push(Finding {
+            fatal: false,
+            message,
+        });
+    }
+    Ok(found)
+}
+
+/// Whether the camera is outside the scene's bounds, or sees mostly backs or nothing.
+fn camera(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
+    let mut found = Vec::new();
+    let c = scene.camera();
+    let b = scene.bounds();
+    let pad = 1e-3 * b.diagonal();
+    if (c.position.cmplt(b.min - Vec3::splat(pad)) | c.position.cmpgt(b.max + Vec3::splat(pad)))
+        .any()
+    {
+        found.push(Finding {
+            fatal: false,
+            message: format!(
+                "the camera at {} is outside the scene, whose bounds are {} to {}: is its \
+                 position in the scene's coordinates (+Y up; Blender's are Z-up)?",
+                c.position, b.min, b.max
+            ),
+        });
+    }
+    let n = CAMERA_GRID;
+    let rays: Vec<Ray> = (0..n * n)
+        .map(|k| {
+            let (i, j) = (k % n, k / n);
+            let x = (i as f32 + 0.5) / n as f32 * c.width as f32;
+            let y = (j as f32 + 0.5) / n as f32 * c.height as f32;
+            Ray {
+                origin: c.position,
+                dir: c.direction(x, y),
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            }
+        })
+        .collect();
+    let mut hits = vec![None; rays.len()];
+    vis.intersect(&rays, &mut hits)?;
+    let (mut away, mut back) = (0usize, 0usize);
+    for (ray, hit) in rays.iter().zip(hits) {
+        match landing(scene, ray, hit) {
+            Landing::Away => away += 1,
+            Landing::Back(_) => back += 1,
+            Landing::Front => {}
+        }
+    }
+    let all = rays.len() as f64;
+    if (away + back) as f64 / all > MOST {
+        found.push(Finding {
+            fatal: false,
+            message: format!(
+                "the camera sees little of the scene: {:.0}% of its view is empty and {:.0}% \
+                 the backs of one-sided faces (black). Check its position and look_at, and the \
+                 faces' orientation (two_sided = true).",
+                100.0 * away as f64 / all,
+                100.0 * back as f64 / all
+            ),
+        });
+    }
+    Ok(found)
+}
+
+/// The check on a finished image: black, or nearly, though the scene emits light.
+pub fn image(scene: &Scene, image: &crate::Image) -> Option<Finding> {
+    let mean = image.mean();
+    let emitted = scene.emitted_power().max_element();
+    // A lit scene's image is black to a millionth of its lights' radiance scale only when nothing
+    // lit is in view.
+    let scale = emitted / scene.total_area().max(f64::MIN_POSITIVE) / std::f64::consts::PI;
+    (emitted > 0.0 && mean <= 1e-6 * scale.max(f64::MIN_POSITIVE)).then(|| Finding {
+        fatal: false,
+        message: format!(
+            "the image is black (mean radiance {mean:.3e}): the camera sees nothing the light \
+             reaches. Likely causes: the camera is outside the room or looks at the backs of \
+             its faces, or the light faces away from the scene."
+        ),
+    })
+}

@@ -1,0 +1,142 @@
+//! The checks for scenes that would give a black or wrong image without an error: each fires
+//! on the broken scene it is about, and none fires on the shipped scenes.
+
+mod common;
+
+use common::mirror::{facing_down, facing_up, v};
+use common::{backends, camera, material, Builder};
+use meshlight::diagnose::{before_solve, image, Finding};
+use meshlight::solver::{Control, Options};
+use meshlight::Scene;
+
+fn findings(scene: &Scene) -> Vec<Finding> {
+    let mut all = Vec::new();
+    for backend in backends() {
+        let vis = backend.build(scene).unwrap();
+        let found = before_solve(scene, vis.as_ref()).unwrap();
+        if let Some(first) = all.first() {
+            assert_eq!(&found, first, "{backend} finds otherwise");
+        }
+        all.push(found);
+    }
+    all.swap_remove(0)
+}
+
+fn says(found: &[Finding], words: &str) -> bool {
+    found.iter().any(|f| f.message.contains(words))
+}
+
+/// A closed 4 × 3 × 4 room of grey seen from inside, with what `light` adds.
+fn room(light: impl FnOnce(&mut Builder, u32)) -> Builder {
+    let mut b = Builder::default();
+    let grey = b.material(material("grey", 0.6, 0.0));
+    b.room(v(0.0, 0.0, 0.0), v(4.0, 3.0, 4.0), grey, &[]);
+    let lamp = b.material(material("lamp", 0.0, 10.0));
+    light(&mut b, lamp);
+    b
+}
+
+fn inside() -> meshlight::scene::Camera {
+    camera(v(2.0, 1.5, 0.2), v(2.0, 1.2, 4.0), 32)
+}
+
+#[test]
+fn a_correct_room_raises_nothing() {
+    // The control for every case below: the same room lit from a panel facing down.
+    let scene = room(|b, lamp| facing_down(b, 2.99, [1.5, 2.5], [1.5, 2.5], lamp)).scene(inside());
+    assert_eq!(findings(&scene), vec![]);
+}
+
+#[test]
+fn a_scene_without_light_is_fatal_and_names_the_exporters_habit() {
+    let scene = room(|_, _| {}).scene(inside());
+    let found = findings(&scene);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(found[0].fatal);
+    assert!(says(&found, "nothing in the scene emits light") && says(&found, "Blender"));
+}
+
+#[test]
+fn a_room_whose_faces_point_out_loses_its_light_to_their_backs() {
+    // Blender's cube: every face points out, so the light inside meets only backs.
+    let mut b = Builder::default();
+    let grey = b.material(material("grey", 0.6, 0.0));
+    b.solid(v(0.0, 0.0, 0.0), v(4.0, 3.0, 4.0), grey);
+    let lamp = b.material(material("lamp", 0.0, 10.0));
+    facing_down(&mut b, 2.99, [1.5, 2.5], [1.5, 2.5], lamp);
+    let found = findings(&b.scene(inside()));
+    assert!(!found.iter().any(|f| f.fatal));
+    assert!(says(&found, "most of the light goes astray"), "{found:?}");
+    assert!(says(&found, "material 'grey'") && says(&found, "two_sided"));
+    assert!(
+        says(&found, "the backs of one-sided faces (black)"),
+        "{found:?}"
+    );
+}
+
+#[test]
+fn a_panel_facing_the_ceiling_from_a_centimetre_away_is_trapped() {
+    let scene = room(|b, lamp| facing_up(b, 2.99, [1.5, 2.5], [1.5, 2.5], lamp)).scene(inside());
+    let found = findings(&scene);
+    assert!(says(&found, "faces a surface 0.01"), "{found:?}");
+    assert!(says(&found, "material 'lamp'"));
+}
+
+#[test]
+fn a_light_facing_the_open_sky_sees_nothing() {
+    // A floor and, above it, a panel facing up: its front sees nothing at all.
+    let mut b = Builder::default();
+    let grey = b.material(material("grey", 0.6, 0.0));
+    facing_up(&mut b, 0.0, [0.0, 4.0], [0.0, 4.0], grey);
+    let lamp = b.material(material("lamp", 0.0, 10.0));
+    facing_up(&mut b, 1.0, [1.5, 2.5], [1.5, 2.5], lamp);
+    let found = findings(&b.scene(camera(v(2.0, 3.0, -2.0), v(2.0, 0.0, 2.0), 32)));
+    assert!(says(&found, "faces away from the scene"), "{found:?}");
+    assert!(says(&found, "most of the light goes astray"), "{found:?}");
+}
+
+#[test]
+fn a_camera_under_the_floor_is_outside_and_its_image_is_black() {
+    // The position typed in Blender's Z-up coordinates: (2, 0.2, 1.5) becomes y = −1.5.
+    let build = || room(|b, lamp| facing_down(b, 2.99, [1.5, 2.5], [1.5, 2.5], lamp));
+    let scene = build().scene(camera(v(2.0, -1.5, 0.2), v(2.0, -1.5, 4.0), 16));
+    let found = findings(&scene);
+    assert!(says(&found, "outside the scene"), "{found:?}");
+    // It looks along under the floor, at nothing: the image is black and says so; the same
+    // room seen from inside is not.
+    for (scene, black) in [(scene, true), (build().scene(inside()), false)] {
+        let vis = meshlight::Backend::default_backend().build(&scene).unwrap();
+        let options = Options::preview();
+        let s =
+            meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
+        let (picture, _) = meshlight::render(
+            &scene,
+            &s,
+            vis.as_ref(),
+            &meshlight::RenderOptions::default(),
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
+        let finding = image(&scene, &picture);
+        assert_eq!(finding.is_some(), black, "{finding:?}");
+        if black {
+            assert!(finding.unwrap().message.contains("the image is black"));
+        }
+    }
+}
+
+#[test]
+fn no_shipped_scene_raises_anything() {
+    for name in [
+        "box",
+        "room",
+        "cornell",
+        "mirror-room",
+        "glossy-room",
+        "glass-room",
+        "washroom",
+    ] {
+        let scene = Scene::load(common::shipped(name)).unwrap();
+        assert_eq!(findings(&scene), vec![], "{name}");
+    }
+}
