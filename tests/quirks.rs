@@ -214,3 +214,36 @@ fn the_shipped_gallery_names_its_generator_when_its_obj_is_missing() {
         "{e}"
     );
 }
+
+#[test]
+fn a_usemtl_no_mtl_defines_is_a_warning_and_grey() {
+    // tinyobjloader's corpus has OBJs whose usemtl names a material the MTL lacks, or that
+    // have no mtllib at all: they load, their faces grey (Kd 0.5), with one warning each.
+    let scene = load(
+        &OBJ.replace("usemtl white", "usemtl chalk"),
+        "newmtl white\nKd 0.8 0.8 0.8\n",
+    );
+    assert_eq!(surfaces(&scene), vec![(1.0, Vec3::splat(0.5))]);
+    let said: Vec<&String> = scene
+        .warnings()
+        .iter()
+        .filter(|w| w.contains("usemtl 'chalk'"))
+        .collect();
+    assert_eq!(said.len(), 1, "{:?}", scene.warnings());
+    assert!(said[0].contains("s.obj:6:") && said[0].contains("not defined in"));
+    let bare = load_with(
+        &OBJ.replace("mtllib s.mtl\n", ""),
+        &[],
+        TOML,
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(surfaces(&bare), vec![(1.0, Vec3::splat(0.5))]);
+    assert!(
+        bare.warnings()
+            .iter()
+            .any(|w| w.contains("names no mtllib")),
+        "{:?}",
+        bare.warnings()
+    );
+}

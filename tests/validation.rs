@@ -99,7 +99,6 @@ const CASES: &[Case] = &[
     case(In::Obj, "v 1 1 0", "v 1 one 0", "s.obj:4:", "vertex needs three numbers"),
     case(In::Obj, "f 1 2 3 4", "f 1 2 x 4", "s.obj:7:", "face vertex 'x'"),
     case(In::Obj, "f 1 2 3 4", "f 1 2 3 9", "s.obj:7:", "vertex index 9 is out of range"),
-    case(In::Obj, "usemtl white", "usemtl chalk", "s.obj:6:", "usemtl 'chalk'"),
     case(In::Mtl, "Kd 0.5 0.5 0.5", "Kd 0.5 0.5", "s.mtl:2:", "Kd needs three numbers"),
     case(In::Mtl, "*", "Kd 0.5 0.5 0.5\nnewmtl white\n", "s.mtl:1:", "Kd before any newmtl"),
     case(In::Mtl, "", "newmtl white\nKd 0.1 0.1 0.1\n", "s.mtl:3:", "defined twice"),

@@ -106,7 +106,13 @@ pub(super) fn read(
     let mut materials = materials_from(&tobj_materials, &libraries, rules, &mut warnings)?;
     // A material a missing MTL file may have defined gets the default grey (below).
     if !any_missing {
-        check_usemtl(path, &prepared.usemtl, &materials, &libraries)?;
+        check_usemtl(
+            path,
+            &prepared.usemtl,
+            &materials,
+            &libraries,
+            &mut warnings,
+        );
     }
 
     let mut mesh = Mesh::default();
@@ -661,32 +667,35 @@ fn specular_kind(
     Ok(())
 }
 
-/// Every `usemtl` must name a material some MTL file defines.
+/// A `usemtl` naming a material no MTL file defines is one warning per name; its faces get the
+/// default grey, as faces without a material do (tobj leaves their material unset).
 fn check_usemtl(
     path: &Path,
     usemtl: &[(String, usize)],
     materials: &[Material],
     libraries: &[MtlLibrary],
-) -> Result<()> {
+    warnings: &mut Vec<String>,
+) {
+    let mut said: Vec<&str> = Vec::new();
     for (name, line) in usemtl {
-        if !materials.iter().any(|m| &m.name == name) {
-            let files: Vec<String> = libraries
-                .iter()
-                .map(|l| l.path.display().to_string())
-                .collect();
-            let looked = if files.is_empty() {
-                "the OBJ names no mtllib".to_string()
-            } else {
-                format!("not defined in {}", files.join(", "))
-            };
-            return Err(Error::scene(
-                path,
-                Some(*line),
-                format!("usemtl '{name}': {looked}"),
-            ));
+        if materials.iter().any(|m| &m.name == name) || said.contains(&name.as_str()) {
+            continue;
         }
+        said.push(name);
+        let files: Vec<String> = libraries
+            .iter()
+            .map(|l| l.path.display().to_string())
+            .collect();
+        let looked = if files.is_empty() {
+            "the OBJ names no mtllib".to_string()
+        } else {
+            format!("not defined in {}", files.join(", "))
+        };
+        warnings.push(format!(
+            "{}:{line}: usemtl '{name}': {looked}: its faces get Kd = {DEFAULT_KD} grey",
+            path.display()
+        ));
     }
-    Ok(())
 }
 
 #[cfg(test)]
