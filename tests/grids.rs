@@ -94,6 +94,14 @@ fn grid_errors_name_the_file_and_the_key() {
             ),
             "name used twice",
         ),
+        (
+            grid("origin = [0, 1, 0]\nu = [1, 0, 0]\nv = [0, 0, 1]\ntarget_em = -500"),
+            "target_em -500 must be a positive illuminance",
+        ),
+        (
+            grid("origin = [0, 1, 0]\nu = [1, 0, 0]\nv = [0, 0, 1]\ntarget_u0 = 1.5"),
+            "target_u0 1.5 must be a uniformity in (0, 1]",
+        ),
     ];
     for (body, problem) in cases {
         let e = floor_scene(&body).unwrap_err().to_string();

@@ -136,14 +136,73 @@ pub fn run(
             ],
         )?;
         println!("{line}");
+        if let Some(verdict) = targets(grid.target_em(), grid.target_u0(), &s, unit) {
+            println!("grid '{}': {verdict}", grid.name());
+        }
         println!("wrote {} and {}", csv.display(), png.display());
     }
     Ok(())
 }
 
+/// Whether a grid meets its targets, and by how much: "meets Ēm 500 lx (+12.3%) and U0 0.6
+/// (0.71)" or "does NOT meet Ēm 500 lx: 46.100 lx short (-9.2%)". None without targets.
+fn targets(em: Option<f64>, u0: Option<f64>, s: &Summary, unit: &str) -> Option<String> {
+    let mut met = Vec::new();
+    let mut failed = Vec::new();
+    if let Some(em) = em {
+        let margin = 100.0 * (s.avg / em - 1.0);
+        if s.avg >= em {
+            met.push(format!("Ēm {em} {unit} ({margin:+.1}%)"));
+        } else {
+            failed.push(format!(
+                "Ēm {em} {unit}: {:.3} {unit} short ({margin:+.1}%)",
+                em - s.avg
+            ));
+        }
+    }
+    if let Some(u0) = u0 {
+        let have = s.uniformity();
+        if have >= u0 {
+            met.push(format!("U0 {u0} ({have:.2})"));
+        } else {
+            failed.push(format!("U0 {u0}: only {have:.2}"));
+        }
+    }
+    match (met.is_empty(), failed.is_empty()) {
+        (true, true) => None,
+        (_, true) => Some(format!("meets its targets: {}", met.join(" and "))),
+        (true, false) => Some(format!("does NOT meet {}", failed.join("; nor "))),
+        (false, false) => Some(format!(
+            "does NOT meet {}; meets {}",
+            failed.join("; nor "),
+            met.join(" and ")
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::Summary;
+    use super::{targets, Summary};
+
+    #[test]
+    fn targets_met_and_missed_with_their_margins() {
+        let s = Summary::of(&[300.0, 500.0, 700.0]);
+        // Ēm 500, U0 0.6: the average just meets 500, the uniformity 300/500 just meets 0.6.
+        assert_eq!(
+            targets(Some(500.0), Some(0.6), &s, "lx").unwrap(),
+            "meets its targets: Ēm 500 lx (+0.0%) and U0 0.6 (0.60)"
+        );
+        // 550 lx asked: 50 short, −9.1%; U0 0.7 asked: only 0.60.
+        assert_eq!(
+            targets(Some(550.0), Some(0.7), &s, "lx").unwrap(),
+            "does NOT meet Ēm 550 lx: 50.000 lx short (-9.1%); nor U0 0.7: only 0.60"
+        );
+        assert_eq!(
+            targets(Some(400.0), Some(0.7), &s, "lx").unwrap(),
+            "does NOT meet U0 0.7: only 0.60; meets Ēm 400 lx (+25.0%)"
+        );
+        assert_eq!(targets(None, None, &s, "lx"), None);
+    }
 
     #[test]
     fn summaries_by_hand_and_of_nothing() {

@@ -400,7 +400,8 @@ fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
         std::fs::copy(root(&format!("scenes/box/{f}")), dir.path().join(f)).unwrap();
     }
     let toml = std::fs::read_to_string(root("scenes/box/scene.toml")).unwrap()
-        + "\n[[grid]]\nname = \"mid plane\"\norigin = [0.2, 0.5, 0.2]\nu = [0.6, 0, 0]\nv = [0, 0, 0.4]\nspacing = 0.2\n";
+        + "\n[[grid]]\nname = \"mid plane\"\norigin = [0.2, 0.5, 0.2]\nu = [0.6, 0, 0]\nv = [0, 0, 0.4]\nspacing = 0.2\ntarget_em = 0.5\ntarget_u0 = 0.9\n"
+        + "\n[[grid]]\nname = \"asks too much\"\norigin = [0.2, 0.3, 0.2]\nu = [0.6, 0, 0]\nv = [0, 0, 0.4]\nspacing = 0.2\ntarget_em = 1.0\n";
     std::fs::write(&scene, toml).unwrap();
     let out_dir = dir.path().join("lux");
     let out = meshlight(&[
@@ -415,6 +416,17 @@ fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
         .lines()
         .find(|l| l.starts_with("grid 'mid plane': 6 points"))
         .unwrap_or_else(|| panic!("{stdout}"));
+    // Targets: π · 0.2 = 0.628 (within 2%) meets 0.5 by 23–28% and U0 0.9; 1.0 is 0.36–0.38
+    // short, 36–39%.
+    assert!(
+        stdout.contains("grid 'mid plane': meets its targets: Ēm 0.5 W/m² (+2"),
+        "{stdout}"
+    );
+    let short = stdout
+        .lines()
+        .find(|l| l.starts_with("grid 'asks too much': does NOT meet Ēm 1 W/m²: 0.3"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(short.contains("short (-3"), "{short}");
     let csv = std::fs::read_to_string(out_dir.join("mid_plane.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows[0], "x,y,z,E");

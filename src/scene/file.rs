@@ -85,6 +85,8 @@ struct GridToml {
     v: [f32; 3],
     normal: Option<[f32; 3]>,
     spacing: Option<f32>,
+    target_em: Option<f64>,
+    target_u0: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -186,6 +188,7 @@ fn grid(g: GridToml, fail: &dyn Fn(String) -> Error) -> Result<Grid> {
         g.normal.map(Vec3::from),
         g.spacing,
     )
+    .and_then(|grid| grid.with_targets(g.target_em, g.target_u0))
     .map_err(|problem| fail(format!("grid '{name}': {problem}")))
 }
 

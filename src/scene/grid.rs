@@ -18,6 +18,10 @@ pub struct Grid {
     pub(crate) spacing: f32,
     pub(crate) n_u: u32,
     pub(crate) n_v: u32,
+    /// What the task area must reach: the average Ēm (the scene's irradiance unit) and the
+    /// uniformity U0 = Emin / Ēm.
+    pub(crate) target_em: Option<f64>,
+    pub(crate) target_u0: Option<f64>,
 }
 
 impl Grid {
@@ -71,7 +75,39 @@ impl Grid {
             spacing,
             n_u,
             n_v,
+            target_em: None,
+            target_u0: None,
         })
+    }
+
+    /// The grid with targets (`docs/scene-format.md`, "Grid targets"): the average Ēm it must
+    /// reach, a positive illuminance, and the uniformity U0 = Emin / Ēm, in (0, 1].
+    pub fn with_targets(mut self, em: Option<f64>, u0: Option<f64>) -> Result<Grid, String> {
+        if let Some(em) = em {
+            if !(em.is_finite() && em > 0.0) {
+                return Err(format!("target_em {em} must be a positive illuminance"));
+            }
+        }
+        if let Some(u0) = u0 {
+            if !(u0 > 0.0 && u0 <= 1.0) {
+                return Err(format!(
+                    "target_u0 {u0} must be a uniformity in (0, 1]: Emin / Em"
+                ));
+            }
+        }
+        self.target_em = em;
+        self.target_u0 = u0;
+        Ok(self)
+    }
+
+    /// The average illuminance Ēm the grid must reach, if it has a target.
+    pub fn target_em(&self) -> Option<f64> {
+        self.target_em
+    }
+
+    /// The uniformity Emin / Ēm the grid must reach, if it has a target.
+    pub fn target_u0(&self) -> Option<f64> {
+        self.target_u0
     }
 
     /// Its name, unique in the scene.
