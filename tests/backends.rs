@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use meshlight::visibility::workload::{camera_rays, facing_segments};
-use meshlight::visibility::{intersect_all, occluded_all};
+use meshlight::visibility::{intersect_all, occluded_all, Visibility};
 use meshlight::visibility::{BvhPreset, BvhScene, EmbreeOptions, EmbreeScene, Hit, Ray, Segment};
 use meshlight::Scene;
 
@@ -138,5 +138,66 @@ fn both_backends_see_the_known_answer_through_the_room() {
         vis.occluded(&[floor_to_ceiling, through_box], &mut blocked)
             .unwrap();
         assert_eq!(blocked, [false, true], "{}", vis.name());
+    }
+}
+
+#[test]
+fn rays_embree_cannot_take_are_refused_not_an_abort() {
+    // Embree asserts (and the process dies) on NaN or huge coordinates and NaN or negative
+    // distances, obvhs on non-finite ones; the library checks every batch first and refuses
+    // the first bad ray by its index, on both backends.
+    let scene = Scene::load(shipped("box")).unwrap();
+    let embree = EmbreeScene::new(&scene, EmbreeOptions::default()).unwrap();
+    let bvh = BvhScene::new(&scene, BvhPreset::default());
+    let good = Ray {
+        origin: glam::Vec3::splat(0.5),
+        dir: glam::Vec3::X,
+        t_min: 0.0,
+        t_max: f32::INFINITY,
+    };
+    let nan = f32::NAN;
+    let bad = [
+        Ray {
+            origin: glam::Vec3::new(nan, 0.5, 0.5),
+            ..good
+        },
+        Ray {
+            dir: glam::Vec3::new(f32::INFINITY, 0.0, 0.0),
+            ..good
+        },
+        Ray { t_min: nan, ..good },
+        Ray {
+            t_min: -1.0,
+            ..good
+        },
+        Ray { t_max: nan, ..good },
+        Ray {
+            origin: glam::Vec3::splat(1e30),
+            ..good
+        },
+    ];
+    for ray in bad {
+        let mut out = [None, None];
+        let e = embree
+            .intersect(&[good, ray], &mut out)
+            .expect_err("a bad ray refused");
+        assert!(e.to_string().contains("ray 1 of 2"), "{e}");
+        let e = bvh.intersect(&[good, ray], &mut out).expect_err("refused");
+        assert!(e.to_string().contains("ray 1 of 2"), "{e}");
+    }
+    // The good ray alone is answered: the box's wall at x = 1, half a unit away.
+    let mut out = [None];
+    embree.intersect(&[good], &mut out).unwrap();
+    assert!((out[0].unwrap().t - 0.5).abs() < 1e-4);
+    for b in [glam::Vec3::new(nan, 0.0, 0.0), glam::Vec3::splat(1e30)] {
+        let s = Segment {
+            a: glam::Vec3::splat(0.5),
+            b,
+        };
+        let mut out = [false];
+        let e = embree.occluded(&[s], &mut out).expect_err("refused");
+        assert!(e.to_string().contains("segment 0 of 1"), "{e}");
+        let e = bvh.occluded(&[s], &mut out).expect_err("refused");
+        assert!(e.to_string().contains("segment 0 of 1"), "{e}");
     }
 }

@@ -153,6 +153,7 @@ impl Visibility for BvhScene {
 
     fn occluded(&self, segments: &[Segment], out: &mut [bool]) -> Result<()> {
         check_lengths("bvh", segments.len(), out.len())?;
+        super::check_segments(segments)?;
         let tris = &self.triangles;
         for (s, o) in segments.iter().zip(out.iter_mut()) {
             let ray =
@@ -169,6 +170,7 @@ impl Visibility for BvhScene {
 
     fn intersect(&self, rays: &[Ray], out: &mut [Option<Hit>]) -> Result<()> {
         check_lengths("bvh", rays.len(), out.len())?;
+        super::check_rays(rays)?;
         let tris = &self.triangles;
         for (r, o) in rays.iter().zip(out.iter_mut()) {
             let ray = obvhs::ray::Ray::new(r.origin.into(), r.dir.into(), r.t_min, r.t_max);

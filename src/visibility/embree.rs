@@ -6,7 +6,10 @@ use std::ptr::NonNull;
 
 use meshlight_embree_sys as sys;
 
-use super::{check_lengths, Hit, Ray, Segment, Visibility, SEGMENT_T_MAX, SEGMENT_T_MIN};
+use super::{
+    check_lengths, check_rays, check_segments, Hit, Ray, Segment, Visibility, SEGMENT_T_MAX,
+    SEGMENT_T_MIN,
+};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 
@@ -161,6 +164,7 @@ impl EmbreeScene {
         out: &mut [bool],
     ) -> Result<()> {
         check_lengths("embree", segments.len(), out.len())?;
+        check_segments(segments)?;
         // SAFETY: Segment has ml_segment's layout (asserted above); both slices hold n items;
         // the scene is live for &self.
         let status = unsafe {
@@ -185,6 +189,7 @@ impl EmbreeScene {
         out: &mut [Option<Hit>],
     ) -> Result<()> {
         check_lengths("embree", rays.len(), out.len())?;
+        check_rays(rays)?;
         const CHUNK: usize = 256;
         let mut hits = [sys::ml_hit::default(); CHUNK];
         for (rays, out) in rays.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {

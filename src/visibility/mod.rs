@@ -187,6 +187,63 @@ pub(crate) fn check_lengths(backend: &'static str, queries: usize, out: usize) -
     }
 }
 
+/// Embree asserts, and so aborts the process, on a ray with a coordinate beyond its
+/// `FLT_LARGE` (1.844e18) or NaN, or a NaN distance, and obvhs asserts finite rays: both
+/// backends check every batch before tracing it, in release builds too (one pass over the
+/// rays, next to nothing beside tracing them), and refuse the first bad one by name.
+const LARGE: f32 = 1.8e18;
+
+fn within(v: glam::Vec3, bound: f32) -> bool {
+    v.is_finite() && v.abs().max_element() <= bound
+}
+
+/// The first ray Embree cannot take, as an error naming it.
+pub(crate) fn check_rays(rays: &[Ray]) -> Result<()> {
+    for (i, r) in rays.iter().enumerate() {
+        let problem = if !within(r.origin, LARGE) {
+            format!("origin {}", r.origin)
+        } else if !within(r.dir, LARGE) {
+            format!("direction {}", r.dir)
+        } else if !(r.t_min.is_finite() && r.t_min >= 0.0) {
+            format!("t_min {}", r.t_min)
+        } else if r.t_max.is_nan() || r.t_max < r.t_min {
+            format!("t_max {} (t_min {})", r.t_max, r.t_min)
+        } else {
+            continue;
+        };
+        return Err(Error::Argument {
+            argument: "rays",
+            problem: format!(
+                "ray {i} of {}: {problem}: a ray needs finite coordinates within ±{LARGE:e} \
+                 and 0 ≤ t_min ≤ t_max",
+                rays.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The first segment Embree cannot take (ends within half the range, so that their
+/// difference, the direction, is within it too).
+pub(crate) fn check_segments(segments: &[Segment]) -> Result<()> {
+    for (i, s) in segments.iter().enumerate() {
+        if !within(s.a, 0.5 * LARGE) || !within(s.b, 0.5 * LARGE) {
+            return Err(Error::Argument {
+                argument: "segments",
+                problem: format!(
+                    "segment {i} of {}: {} to {}: its ends need finite coordinates within \
+                     ±{:e}",
+                    segments.len(),
+                    s.a,
+                    s.b,
+                    0.5 * LARGE
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Occlusion of many segments on up to `threads` threads (batches of 4,096), for tests and
 /// tools.
 pub fn occluded_all(
