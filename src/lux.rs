@@ -269,12 +269,7 @@ impl SpecularGather<'_> {
             .ends
             .iter()
             .zip(covered)
-            .map(|(e, covered)| Site {
-                point: e.point,
-                side: e.side,
-                normal: e.normal,
-                covered,
-            })
+            .map(|(e, covered)| e.site(covered))
             .collect();
         let mut weights = Vec::new();
         self.interpolator.weights(&sites, &mut weights)?;

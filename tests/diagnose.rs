@@ -6,7 +6,7 @@ mod common;
 use common::mirror::{facing_down, facing_up, v};
 use common::{backends, camera, material, Builder};
 use meshlight::diagnose::{before_solve, image, Finding};
-use meshlight::solver::{Control, Options};
+use meshlight::solver::Options;
 use meshlight::Scene;
 
 fn findings(scene: &Scene) -> Vec<Finding> {
@@ -105,18 +105,12 @@ fn a_camera_under_the_floor_is_outside_and_its_image_is_black() {
     // It looks along under the floor, at nothing: the image is black and says so; the same
     // room seen from inside is not.
     for (scene, black) in [(scene, true), (build().scene(inside()), false)] {
-        let vis = meshlight::Backend::default_backend().build(&scene).unwrap();
-        let options = Options::preview();
-        let s =
-            meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
-        let (picture, _) = meshlight::render(
+        let (_, picture) = common::solve_and_render(
             &scene,
-            &s,
-            vis.as_ref(),
-            &meshlight::RenderOptions::default(),
-            &mut |_| Control::Continue,
-        )
-        .unwrap();
+            meshlight::Backend::default_backend(),
+            Options::preview(),
+            true,
+        );
         let finding = image(&scene, &picture);
         assert_eq!(finding.is_some(), black, "{finding:?}");
         if black {

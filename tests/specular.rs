@@ -415,23 +415,14 @@ fn a_scene_without_specular_materials_ignores_the_specular_knobs() {
     // The specular machinery costs nothing and changes nothing where no surface is specular:
     // depth 0 and depth 16 with 4096 rays give the same numbers bit for bit.
     let scene = shipped_at("box", 24);
-    let vis = meshlight::Backend::default_backend().build(&scene).unwrap();
     let run = |depth: u32, rays: u32| {
         let options = Options {
             specular_depth: depth,
             specular_rays: rays,
             ..Options::default()
         };
-        let s =
-            meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
-        let (image, _) = meshlight::render(
-            &scene,
-            &s,
-            vis.as_ref(),
-            &meshlight::RenderOptions::default(),
-            &mut |_| Control::Continue,
-        )
-        .unwrap();
+        let (s, image) =
+            common::solve_and_render(&scene, meshlight::Backend::default_backend(), options, true);
         (s.radiosity().to_vec(), image)
     };
     let (a, b) = (run(0, 64), run(16, 4096));

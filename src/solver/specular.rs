@@ -109,12 +109,7 @@ impl Transfer {
             .ends
             .iter()
             .zip(&covered)
-            .map(|(e, &covered)| Site {
-                point: e.point,
-                side: e.side,
-                normal: e.normal,
-                covered,
-            })
+            .map(|(e, &covered)| e.site(covered))
             .collect();
         let mut weights = Vec::new();
         let queries = interpolator.weights(&sites, &mut weights)? + covered.len() as u64;
