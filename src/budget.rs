@@ -30,6 +30,62 @@ pub fn human_bytes(bytes: f64) -> String {
     }
 }
 
+/// A count for messages: digits grouped below a billion ("1,234,567"), three significant
+/// figures in scientific notation above ("5.60e55"), so a mistaken input never prints a
+/// number sixty digits long.
+pub fn human_count(count: f64) -> String {
+    if !count.is_finite() || count.abs() >= 1e9 {
+        return format!("{count:.2e}");
+    }
+    let digits = format!("{:.0}", count.abs());
+    let mut grouped = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            grouped.push(',');
+        }
+        grouped.push(c);
+    }
+    if count < -0.5 {
+        grouped.insert(0, '-');
+    }
+    grouped
+}
+
+/// A number for messages: as Rust prints it between 0.001 and a million, in scientific notation
+/// outside ("1e-12", "2.4e14").
+pub fn human_number(x: f32) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Bytes an image's working arrays take per pixel at most while it is computed (the camera
+/// hits, the radiance, the edge pixels' lists and their refined values), for the budget.
+pub const BYTES_PER_PIXEL: usize = 96;
+
+/// Refuses an image of `width` × `height` pixels, at `per_pixel` bytes each, that the budget
+/// cannot hold, before anything is allocated.
+pub(crate) fn check_image(
+    budget: usize,
+    (width, height): (u32, u32),
+    per_pixel: usize,
+) -> crate::Result<()> {
+    let bytes = f64::from(width) * f64::from(height) * per_pixel as f64;
+    if bytes > budget as f64 {
+        return Err(exceeded(
+            budget,
+            format!(
+                "a {width}×{height} image needs about {} ({per_pixel} bytes a pixel): make the \
+                 camera smaller or raise the budget",
+                human_bytes(bytes)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The error for work that would not fit: `what` needs `needed` bytes of `available`.
 pub(crate) fn exceeded(budget: usize, problem: String) -> crate::Error {
     crate::Error::Budget { budget, problem }
@@ -44,5 +100,15 @@ mod tests {
         assert_eq!(human_bytes(1000.0), "1000 bytes");
         assert_eq!(human_bytes(1536.0), "1.5 KiB");
         assert_eq!(human_bytes(8.0 * 1024.0 * 1024.0 * 1024.0), "8.0 GiB");
+    }
+
+    #[test]
+    fn counts_are_grouped_or_short() {
+        assert_eq!(human_count(0.0), "0");
+        assert_eq!(human_count(999.0), "999");
+        assert_eq!(human_count(1000.0), "1,000");
+        assert_eq!(human_count(1_234_567.4), "1,234,567");
+        assert_eq!(human_count(-4321.0), "-4,321");
+        assert_eq!(human_count(5.6e55), "5.60e55");
     }
 }

@@ -88,6 +88,8 @@ fn sphere_direction(rng: &mut Pcg64Mcg) -> Vec3 {
 /// leaves the scene or falls on backs, an area light whose front sees nothing, a camera
 /// outside the scene or looking mostly at backs or into the void. Deterministic.
 pub fn before_solve(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
+    let checked = crate::visibility::Checked::new(vis, scene);
+    let vis: &dyn Visibility = &checked;
     let mut found = Vec::new();
     if scene.emitted_power().max_element() <= 0.0 {
         found.push(Finding {

@@ -72,6 +72,8 @@ pub fn illuminance(
     progress: Callback,
 ) -> Result<Illuminance> {
     crate::parallel::guarded("the illuminance gather", || {
+        let checked = crate::visibility::Checked::new(vis, scene);
+        let vis: &dyn crate::visibility::Visibility = &checked;
         solution.check_fits(scene)?;
         if !(1..=crate::solver::MAX_SPECULAR_RAYS).contains(&options.specular_rays) {
             return Err(crate::Error::argument(
@@ -293,6 +295,8 @@ impl SpecularGather<'_> {
 /// first surface a ray along the grid's normal meets is seen from behind. Such points receive
 /// nothing; a summary leaves them out.
 pub fn enclosed(scene: &Scene, vis: &dyn Visibility, grid: &Grid) -> Result<Vec<bool>> {
+    let checked = crate::visibility::Checked::new(vis, scene);
+    let vis: &dyn Visibility = &checked;
     let points = grid.points();
     let reach = 2.0 * scene.bounds.diagonal();
     let rays: Vec<crate::visibility::Ray> = points

@@ -13,19 +13,22 @@ use crate::progress::Control;
 /// Runs `f`, turning a panic (in a host's own `Visibility`, say) into [`Error::Worker`] naming
 /// `what` and the panic's message: a host must never be taken down by the library.
 pub(crate) fn guarded<R>(what: &str, f: impl FnOnce() -> Result<R>) -> Result<R> {
-    match catch_unwind(AssertUnwindSafe(f)) {
-        Ok(result) => result,
-        Err(panic) => {
-            let message = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "a panic without a message".into());
-            Err(Error::Worker {
-                problem: format!("{what} panicked: {message}"),
-            })
-        }
-    }
+    caught(f).unwrap_or_else(|message| {
+        Err(Error::Worker {
+            problem: format!("{what} panicked: {message}"),
+        })
+    })
+}
+
+/// Runs `f`; its panic's message if it panicked.
+pub(crate) fn caught<R>(f: impl FnOnce() -> R) -> std::result::Result<R, String> {
+    catch_unwind(AssertUnwindSafe(f)).map_err(|panic| {
+        panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic without a message".into())
+    })
 }
 
 /// Fills `out` chunk by chunk: `f(first_index, chunk)`, on up to `threads` threads.
@@ -75,9 +78,12 @@ pub(crate) fn for_chunks<T: Send>(
 /// called on the calling thread between parts of the work; the answer says whether to go on.
 pub(crate) type Report<'a> = &'a mut dyn FnMut(f64) -> Control;
 
-/// [`for_chunks`] in about `PARTS` parts, with `report` after each. Part boundaries fall on chunk
-/// boundaries, so the chunks and their results are the same as one call's. Whether every part
-/// was done: a [`Control::Stop`] leaves the parts after it untouched.
+/// [`for_chunks`] in parts, with `report` after each: at least `PARTS` parts, and parts sized
+/// to take about `PART_SECONDS` each (a slow backend gets small parts), so a host hears from
+/// the call several times a second and a Stop is honoured within about that. Part boundaries
+/// fall on chunk boundaries, so the chunks and their results are the same as one call's.
+/// `report(0.0)` is asked first: a Stop already given leaves everything untouched. Whether
+/// every part was done: a [`Control::Stop`] leaves the parts after it untouched.
 pub(crate) fn for_chunks_reporting<T: Send>(
     out: &mut [T],
     chunk: usize,
@@ -86,17 +92,34 @@ pub(crate) fn for_chunks_reporting<T: Send>(
     report: Report,
 ) -> Result<bool> {
     const PARTS: usize = 20;
+    const PART_SECONDS: f64 = 0.2;
     let chunk = chunk.max(1);
+    let threads = threads.max(1);
     let total = out.len();
-    let part = total.div_ceil(PARTS).div_ceil(chunk).max(1) * chunk;
+    if total > 0 && report(0.0) == Control::Stop {
+        return Ok(false);
+    }
+    let largest = total.div_ceil(PARTS).div_ceil(chunk).max(1) * chunk;
+    // Start with a chunk per thread; then as many as take about PART_SECONDS.
+    let mut part = (threads * chunk).min(largest);
     let mut done = 0;
-    for piece in out.chunks_mut(part) {
-        let len = piece.len();
-        for_chunks(piece, chunk, threads, |i, c| f(done + i, c))?;
+    while done < total {
+        let len = part.min(total - done);
+        let first = done;
+        let started = std::time::Instant::now();
+        for_chunks(&mut out[first..first + len], chunk, threads, |i, c| {
+            f(first + i, c)
+        })?;
         done += len;
-        if report(done as f64 / total.max(1) as f64) == Control::Stop && done < total {
+        if report(done as f64 / total as f64) == Control::Stop && done < total {
             return Ok(false);
         }
+        let per_item = started.elapsed().as_secs_f64() / len as f64;
+        let wanted = (PART_SECONDS / per_item.max(1e-12)).min(total as f64) as usize;
+        part = (wanted / chunk)
+            .max(threads)
+            .saturating_mul(chunk)
+            .min(largest);
     }
     Ok(true)
 }
@@ -149,9 +172,32 @@ mod tests {
             },
         );
         assert!(!all.unwrap());
+        // Asked first: nothing is done.
         assert_eq!(reports, 1);
+        assert!(out.iter().all(|&x| x == 0));
+
+        let mut reports = 0;
+        let all = for_chunks_reporting(
+            &mut out,
+            10,
+            2,
+            |_, c| {
+                c.fill(1);
+                Ok(())
+            },
+            &mut |f| {
+                reports += 1;
+                if f > 0.0 {
+                    Control::Stop
+                } else {
+                    Control::Continue
+                }
+            },
+        );
+        assert!(!all.unwrap());
+        assert_eq!(reports, 2);
         let done = out.iter().filter(|&&x| x == 1).count();
-        assert_eq!(done, 50, "one part of the twenty");
+        assert_eq!(done, 20, "the first part: a chunk per thread");
         assert!(out[done..].iter().all(|&x| x == 0));
     }
 }

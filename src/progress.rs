@@ -161,6 +161,14 @@ impl<'a> Reporter<'a> {
         base: Progress,
     ) -> impl FnMut(f64) -> Control + use<'r, 'a> {
         move |fraction| {
+            // A share of 0 asks whether to begin: the host heard the phase begin already.
+            if fraction <= 0.0 {
+                return if self.stopped {
+                    Control::Stop
+                } else {
+                    Control::Continue
+                };
+            }
             let stop = self.report(Progress { fraction, ..base });
             if stop {
                 Control::Stop

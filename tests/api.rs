@@ -223,11 +223,13 @@ fn a_backend_that_panics_ends_the_solve_with_an_error_not_a_hang() {
                 start.elapsed()
             );
             assert!(vis.calls.load(Ordering::Relaxed) >= 1000);
-            let Error::Worker { problem } = &e else {
+            // The panic is caught at the call, and the error names the backend and the call.
+            let Error::Backend { backend, problem } = &e else {
                 panic!("{threads} threads: {e}")
             };
+            assert_eq!(*backend, vis.name());
             assert!(
-                problem.contains("broke on call 1000"),
+                problem.contains("broke on call 1000") && problem.contains("panicked"),
                 "{threads} threads: {problem}"
             );
         }

@@ -53,7 +53,10 @@ fn a_budget_too_small_is_refused_before_allocating_and_names_the_predicted_size(
     let samples = 0.7 * area / (0.25f64 * 0.25) + 16.0;
     let mib = samples * BYTES_PER_SAMPLE as f64 / (1024.0 * 1024.0);
     assert!(
-        problem.contains(&format!("about {samples:.0} samples")),
+        problem.contains(&format!(
+            "about {} samples",
+            meshlight::budget::human_count(samples)
+        )),
         "{problem}"
     );
     assert!(problem.contains(&format!("{mib:.1} MiB")), "{problem}");

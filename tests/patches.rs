@@ -157,8 +157,8 @@ fn bad_patch_sizes_are_clear_errors() {
     for (size, expected) in [
         (0.0, "must be a positive length, not 0"),
         (f32::NAN, "must be a positive length, not NaN"),
-        (0.001, "more than the 3200000 allowed"),
-        (0.01, "more than the 200000 allowed"),
+        (0.001, "more than the 3,200,000 allowed"),
+        (0.01, "more than the 200,000 allowed"),
     ] {
         let options = PatchOptions {
             patch_size: size,

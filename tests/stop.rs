@@ -228,3 +228,96 @@ fn the_path_tracer_stops_after_a_pass_and_the_patch_solver_renders_its_estimate(
     assert!(patches.image.pixels.iter().all(|p| p.is_finite()));
     assert!(patches.image.mean() > 0.0);
 }
+
+/// A backend that takes `delay` over every call once `slow` is set, as a host's remote or
+/// instrumented ray caster may (fast before, so a test reaches every phase in good time).
+struct Slow {
+    inner: Box<dyn meshlight::Visibility>,
+    delay: std::time::Duration,
+    slow: std::sync::atomic::AtomicBool,
+}
+
+impl Slow {
+    fn wait(&self) {
+        if self.slow.load(std::sync::atomic::Ordering::Relaxed) {
+            std::thread::sleep(self.delay);
+        }
+    }
+}
+
+impl meshlight::Visibility for Slow {
+    fn name(&self) -> &'static str {
+        "slow"
+    }
+    fn occluded(
+        &self,
+        segments: &[meshlight::visibility::Segment],
+        out: &mut [bool],
+    ) -> meshlight::Result<()> {
+        self.wait();
+        self.inner.occluded(segments, out)
+    }
+    fn intersect(
+        &self,
+        rays: &[meshlight::visibility::Ray],
+        out: &mut [Option<meshlight::visibility::Hit>],
+    ) -> meshlight::Result<()> {
+        self.wait();
+        self.inner.intersect(rays, out)
+    }
+}
+
+#[test]
+fn a_stop_is_honoured_within_a_second_with_a_slow_backend() {
+    // From the Stop on, the backend takes 20 ms a call: the room's solve would take minutes
+    // that way. A Stop answered at the first report of any phase, or later within it, must end
+    // the call within 1 s plus one call of the backend.
+    let scene = room();
+    let options = Options {
+        rounds: 2,
+        ..Options::default()
+    };
+    let phases = [
+        Phase::Sampling,
+        Phase::Areas,
+        Phase::DirectLight,
+        Phase::Links,
+        Phase::Shooting,
+        Phase::Adaptive,
+    ];
+    for phase in phases {
+        for nth in [1, 3] {
+            let slow = Slow {
+                inner: Backend::Bvh.build(&scene).unwrap(),
+                delay: std::time::Duration::from_millis(20),
+                slow: false.into(),
+            };
+            let mut stopped_at = None;
+            let mut heard = 0;
+            let s = meshlight::solve(&scene, &slow, &options, &mut |p: &Progress| {
+                heard += usize::from(p.phase == phase);
+                if heard >= nth && stopped_at.is_none() {
+                    stopped_at = Some(std::time::Instant::now());
+                    slow.slow.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+                if stopped_at.is_some() {
+                    Control::Stop
+                } else {
+                    Control::Continue
+                }
+            })
+            .unwrap();
+            let Some(at) = stopped_at else {
+                // The phase ended before its nth report: nothing to time.
+                continue;
+            };
+            let after = at.elapsed();
+            println!("stopped at report {nth} of {phase:?}: returned {after:?} later");
+            assert!(
+                after.as_secs_f64() < 1.02,
+                "{phase:?} #{nth}: {after:?} after the Stop"
+            );
+            assert_eq!(s.validate(), Ok(()));
+        }
+    }
+}

@@ -135,6 +135,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
                     _ => meshlight::Quantity::Radiance,
                 },
                 glossy_rays: r.glossy_rays,
+                memory_budget: options.memory_budget,
             };
             let t = std::time::Instant::now();
             let (image, stats) = progress::with_progress("render", |progress| {
@@ -175,6 +176,7 @@ fn path_options(r: &RenderArgs, options: &meshlight::Options) -> meshlight::refe
         seconds: r.time,
         seed: options.seed,
         threads: options.threads,
+        memory_budget: options.memory_budget,
         ..Default::default()
     }
 }
@@ -196,6 +198,7 @@ fn patch_options(
         max_shots: options.max_shots.unwrap_or(u64::MAX),
         seed: options.seed,
         threads: options.threads,
+        memory_budget: options.memory_budget,
         ..Default::default()
     })
 }

@@ -73,6 +73,9 @@ pub struct PathOptions {
     /// row, at most (0 to 4; lowered where a scene has so many mirrors that the chains
     /// would exceed 1,024).
     pub mirror_depth: u32,
+    /// The memory budget, bytes: an image whose sums would not fit is refused before they are
+    /// allocated.
+    pub memory_budget: usize,
 }
 
 impl Default for PathOptions {
@@ -84,6 +87,7 @@ impl Default for PathOptions {
             threads: crate::solver::Options::default().threads,
             max_bounces: 256,
             mirror_depth: 2,
+            memory_budget: crate::budget::DEFAULT_MEMORY_BUDGET,
         }
     }
 }
@@ -267,6 +271,8 @@ pub fn path_trace(
     progress: Callback,
 ) -> Result<PathImage> {
     crate::parallel::guarded("the path tracer", || {
+        let checked = crate::visibility::Checked::new(vis, scene);
+        let vis: &dyn crate::visibility::Visibility = &checked;
         if options.spp < 2 {
             return Err(Error::Option {
                 option: "spp",
@@ -286,6 +292,10 @@ pub fn path_trace(
             });
         }
         scene.camera.check()?;
+        // The two half-sums, the three images returned.
+        let per_pixel = std::mem::size_of::<[DVec3; 2]>() + 3 * std::mem::size_of::<Vec3>();
+        let size = (scene.camera.width, scene.camera.height);
+        crate::budget::check_image(options.memory_budget, size, per_pixel)?;
         let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
         let pixels = w * h;
         let lights = Lights::new(scene);

@@ -43,7 +43,15 @@ pub struct RenderOptions {
     /// samples per area light there), 1 to [`MAX_GLOSSY_RAYS`]: more gives smoother glossy
     /// reflections at proportional cost. Unused in scenes without glossy surfaces.
     pub glossy_rays: u32,
+    /// The memory budget, bytes: an image whose working arrays would not fit
+    /// ([`BYTES_PER_PIXEL`](crate::budget::BYTES_PER_PIXEL) a pixel) is refused before they are
+    /// allocated.
+    pub memory_budget: usize,
 }
+
+/// The most rays per side `supersample` may ask for (edge pixels of high contrast get up to
+/// four times as many).
+pub const MAX_SUPERSAMPLE: u32 = 16;
 
 /// The most rays a glossy bounce may draw.
 pub const MAX_GLOSSY_RAYS: u32 = 1024;
@@ -92,6 +100,7 @@ impl Default for RenderOptions {
             quantity: Quantity::Radiance,
             direct: Direct::Traced { light_samples: 16 },
             glossy_rays: 16,
+            memory_budget: crate::budget::DEFAULT_MEMORY_BUDGET,
         }
     }
 }
@@ -126,6 +135,8 @@ pub fn render(
     progress: Callback,
 ) -> Result<(Image, RenderStats)> {
     crate::parallel::guarded("rendering", || {
+        let checked = crate::visibility::Checked::new(vis, scene);
+        let vis: &dyn crate::visibility::Visibility = &checked;
         let camera = &scene.camera;
         camera.check()?;
         solution.check_fits(scene)?;
@@ -149,6 +160,20 @@ pub fn render(
                 ),
             ));
         }
+        if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
+            return Err(crate::Error::argument(
+                "supersample",
+                format!(
+                    "{} rays per side of an edge pixel: must lie in 1..={MAX_SUPERSAMPLE}",
+                    options.supersample
+                ),
+            ));
+        }
+        crate::budget::check_image(
+            options.memory_budget,
+            (camera.width, camera.height),
+            crate::budget::BYTES_PER_PIXEL,
+        )?;
         let (w, h) = (camera.width as usize, camera.height as usize);
         let shader = Shader::new(scene, solution, vis, options);
         let mut stats = RenderStats::default();

@@ -24,6 +24,7 @@ pub use grid::{Grid, MAX_GRID_POINTS};
 pub use luminaire::{luminance, Luminaire, PointSource};
 pub use material::{roughness_from_ns, Kind, Material};
 pub use source::{Disk, Memory, Source};
+pub use validate::{MAX_OFFSET_IN_DIAGONALS, SCENE_SIZE};
 
 /// A triangle of the scene, after degenerate ones were dropped.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -456,6 +457,9 @@ impl Scene {
             ));
         }
         let bounds = Bounds::around(kept.iter().flat_map(|t| t.vertices));
+        if let Some(problem) = validate::extent(&bounds) {
+            return Err(Error::scene(geometry_path, None, problem));
+        }
         let (triangles, surfaces) =
             surfaces::group(&kept, &mesh.materials, two_sided, bounds.diagonal());
         Ok(Scene {
@@ -534,6 +538,10 @@ impl Scene {
             min: self.bounds.min * s,
             max: self.bounds.max * s,
         };
+        if let Some(problem) = validate::extent(&scene.bounds) {
+            let factor = crate::budget::human_number(s);
+            return Err(Error::argument("scale", format!("× {factor}: {problem}")));
+        }
         scene.solver.epsilon = self.solver.epsilon.map(|e| e * s);
         Ok(scene)
     }

@@ -136,6 +136,13 @@ pub(super) fn group(
 
 /// Which triangles share an edge with which, after welding vertices at equal positions
 /// (exporters often repeat a vertex per face or per object).
+///
+/// Decision: on an edge of k > 2 triangles (duplicated faces, fans, non-manifold CAD edges)
+/// each triangle is linked to its neighbours in the order of its normal's angle about the
+/// edge (within one material), not to all k − 1 others: the memory and time stay linear in
+/// the triangles whatever the mesh. Region growing loses nothing by it: the triangles that fit
+/// a surface (normals within a small cap of its seed's) lie in one run of that order, the
+/// run wrapping round at ±π, so it reaches all of them through their neighbours.
 struct Adjacency {
     offsets: Vec<u32>,
     neighbours: Vec<u32>,
@@ -144,6 +151,7 @@ struct Adjacency {
 impl Adjacency {
     fn new(faces: &[Face]) -> Self {
         let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut welded: Vec<Vec3> = Vec::new();
         let mut weld = |v: Vec3| {
             // `+ 0.0` turns -0.0 into 0.0 so both weld together.
             let key = [
@@ -152,7 +160,10 @@ impl Adjacency {
                 (v.z + 0.0).to_bits(),
             ];
             let next = ids.len() as u32;
-            *ids.entry(key).or_insert(next)
+            *ids.entry(key).or_insert_with(|| {
+                welded.push(v);
+                next
+            })
         };
         let mut edges: Vec<(u64, u32)> = Vec::with_capacity(3 * faces.len());
         for (t, f) in faces.iter().enumerate() {
@@ -165,15 +176,42 @@ impl Adjacency {
             }
         }
         edges.sort_unstable();
-        // Every pair of triangles on one edge are neighbours (non-manifold edges included).
-        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(2 * edges.len());
+        let mut link = |a: u32, b: u32| {
+            if a != b {
+                pairs.push((a, b));
+                pairs.push((b, a));
+            }
+        };
+        let mut around: Vec<(u32, f64, u32)> = Vec::new();
         for run in edges.chunk_by(|x, y| x.0 == y.0) {
-            for (i, &(_, a)) in run.iter().enumerate() {
-                for &(_, b) in &run[i + 1..] {
-                    if a != b {
-                        pairs.push((a, b));
-                        pairs.push((b, a));
-                    }
+            if run.len() == 2 {
+                link(run[0].1, run[1].1);
+                continue;
+            }
+            if run.len() < 2 {
+                continue;
+            }
+            let key = run[0].0;
+            let (a, b) = (welded[(key >> 32) as usize], welded[key as u32 as usize]);
+            let axis = (b - a).as_dvec3().normalize_or(DVec3::X);
+            let (u, v) = axis.any_orthonormal_pair();
+            around.clear();
+            around.extend(run.iter().map(|&(_, t)| {
+                let f = &faces[t as usize];
+                (f.material, f.normal.dot(v).atan2(f.normal.dot(u)), t)
+            }));
+            around.sort_unstable_by(|x, y| {
+                (x.0.cmp(&y.0))
+                    .then(x.1.total_cmp(&y.1))
+                    .then(x.2.cmp(&y.2))
+            });
+            for group in around.chunk_by(|x, y| x.0 == y.0) {
+                for w in group.windows(2) {
+                    link(w[0].2, w[1].2);
+                }
+                if group.len() > 2 {
+                    link(group[group.len() - 1].2, group[0].2);
                 }
             }
         }
@@ -258,6 +296,30 @@ mod tests {
         );
         let (faces, _) = drop_degenerate(&apart);
         assert_eq!(group(&faces, &grey(), false, 8.0).1.len(), 2);
+    }
+
+    #[test]
+    fn a_floor_under_a_wall_on_its_edge_stays_one_surface() {
+        // The floor's two halves meet at the edge x = 0 (both facing +z); a wall (twice, as CAD
+        // exports repeat faces) stands on the same edge, and a slanted fin too: four
+        // triangles and a duplicate on one edge. Floor: one surface; wall: one; fin: one.
+        let m = mesh(
+            &[
+                [0., 0., 0.],
+                [0., 1., 0.],
+                [1., 0.5, 0.],
+                [-1., 0.5, 0.],
+                [0., 0.5, 1.],
+                [0.5, 0.5, 0.5],
+            ],
+            &[[0, 2, 1], [0, 1, 3], [0, 1, 4], [0, 1, 4], [0, 1, 5]],
+        );
+        let (faces, _) = drop_degenerate(&m);
+        let (tris, surfaces) = group(&faces, &grey(), false, 3.0);
+        assert_eq!(surfaces.len(), 3, "{surfaces:?}");
+        let floor = surfaces.iter().find(|s| s.normal.z > 0.99).unwrap();
+        assert!((floor.area - 1.0).abs() < 1e-9, "{}", floor.area);
+        assert_eq!(tris.len(), 5);
     }
 
     #[test]

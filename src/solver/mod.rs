@@ -24,7 +24,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 pub use crate::area::AreaStats;
-use crate::budget::{human_bytes, BYTES_PER_SAMPLE};
+use crate::budget::{human_bytes, human_count, human_number, BYTES_PER_SAMPLE};
 use crate::error::{Error, Result};
 pub use crate::light::Arrival;
 use crate::light::DirectLight;
@@ -317,6 +317,8 @@ pub fn solve(
         Method::Hierarchy
     };
     crate::parallel::guarded("the solver", || {
+        let checked = crate::visibility::Checked::new(vis, scene);
+        let vis: &dyn crate::visibility::Visibility = &checked;
         solve_with(scene, vis, options, progress, method)
     })
 }
@@ -344,9 +346,11 @@ fn solve_with(
         return Err(Error::Option {
             option: "epsilon",
             problem: format!(
-                "ε = {epsilon} would place about {predicted:.0} samples, more than the limit of {} \
+                "ε = {} would place about {} samples, more than the limit of {} \
                  (raise max_samples or choose a larger ε)",
-                options.max_samples
+                human_number(epsilon),
+                human_count(predicted),
+                human_count(options.max_samples as f64)
             ),
         });
     }
@@ -355,9 +359,11 @@ fn solve_with(
         return Err(crate::budget::exceeded(
             options.memory_budget,
             format!(
-                "ε = {epsilon} would place about {predicted:.0} samples, predicted to take {} \
+                "ε = {} would place about {} samples, predicted to take {} \
                  ({BYTES_PER_SAMPLE} bytes each), more than half the budget (the other half is \
                  for links and caches): raise the budget or choose a larger ε",
+                human_number(epsilon),
+                human_count(predicted),
                 human_bytes(predicted_bytes),
             ),
         ));
@@ -441,6 +447,8 @@ pub fn transfer(
     source: DVec3,
 ) -> Result<Vec<DVec3>> {
     crate::parallel::guarded("the transfer", || {
+        let checked = crate::visibility::Checked::new(vis, scene);
+        let vis: &dyn crate::visibility::Visibility = &checked;
         solution.check_fits(scene)?;
         let (samples, maps) = (&solution.samples, &solution.maps);
         if let Some(&j) = shooters.iter().find(|&&j| j as usize >= samples.len()) {
@@ -459,6 +467,13 @@ pub fn transfer(
         Ok(irradiance)
     })
 }
+
+/// The most worker threads a call takes: far beyond any machine this runs on, and well short of
+/// what spawning would exhaust.
+pub const MAX_THREADS: usize = 1024;
+
+/// The most jobs the solver's pipeline may hold in flight ([`Options::pipeline_capacity`]).
+pub const MAX_PIPELINE_CAPACITY: usize = 4096;
 
 fn check(options: &Options) -> Result<()> {
     let fail = |option, problem: String| Err(Error::Option { option, problem });
@@ -506,6 +521,22 @@ fn check(options: &Options) -> Result<()> {
                 "{} must lie in 0..={}",
                 options.specular_depth,
                 crate::specular::MAX_SPECULAR_DEPTH
+            ),
+        );
+    }
+    if !(1..=MAX_THREADS).contains(&options.threads) {
+        return fail(
+            "threads",
+            format!("{} must lie in 1..={MAX_THREADS}", options.threads),
+        );
+    }
+    if !(1..=MAX_PIPELINE_CAPACITY).contains(&options.pipeline_capacity) {
+        return fail(
+            "pipeline_capacity",
+            format!(
+                "{} jobs in flight: it must lie in 1..={MAX_PIPELINE_CAPACITY} (each job in \
+                 flight may hold a group's links, megabytes, against the budget)",
+                options.pipeline_capacity
             ),
         );
     }

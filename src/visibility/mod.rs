@@ -2,6 +2,7 @@
 //! (through our C shim in `ffi/`) or by the pure-Rust `obvhs` BVH.
 
 mod bvh;
+mod checked;
 #[cfg(feature = "embree")]
 mod embree;
 pub mod workload;
@@ -15,6 +16,7 @@ use crate::error::{Error, Result};
 use crate::scene::Scene;
 
 pub use bvh::{BvhPreset, BvhScene};
+pub(crate) use checked::Checked;
 #[cfg(feature = "embree")]
 pub use embree::{
     headers as embree_headers, major as embree_major, EmbreeMode, EmbreeOptions, EmbreeScene,

@@ -34,6 +34,9 @@ pub struct PatchOptions {
     pub seed: u64,
     /// Worker threads (results do not depend on them).
     pub threads: usize,
+    /// The memory budget, bytes: an image that would not fit is refused before it is
+    /// allocated.
+    pub memory_budget: usize,
 }
 
 impl Default for PatchOptions {
@@ -46,6 +49,7 @@ impl Default for PatchOptions {
             supersample: 2,
             seed: 1,
             threads: crate::solver::Options::default().threads,
+            memory_budget: crate::budget::DEFAULT_MEMORY_BUDGET,
         }
     }
 }
@@ -81,6 +85,8 @@ pub fn patch_radiosity(
     progress: Callback,
 ) -> Result<PatchImage> {
     crate::parallel::guarded("the patch solver", || {
+        let checked = crate::visibility::Checked::new(vis, scene);
+        let vis: &dyn crate::visibility::Visibility = &checked;
         check(scene, options)?;
         let size = options.patch_size;
         let mut reporter = Reporter::new(progress);
@@ -201,6 +207,8 @@ fn check(scene: &Scene, options: &PatchOptions) -> Result<()> {
         });
     }
     scene.camera.check()?;
+    let image = (scene.camera.width, scene.camera.height);
+    crate::budget::check_image(options.memory_budget, image, crate::budget::BYTES_PER_PIXEL)?;
     if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
         return Err(Error::Option {
             option: "supersample",
@@ -218,8 +226,10 @@ fn check(scene: &Scene, options: &PatchOptions) -> Result<()> {
         return Err(Error::Option {
             option: "patch_size",
             problem: format!(
-                "{size} lays grids of {cells:.0} cells over the surfaces' bounding boxes, more \
-                 than the {cell_limit:.0} allowed (16 × the patch limit): choose a larger size"
+                "{size} lays grids of {} cells over the surfaces' bounding boxes, more than \
+                 the {} allowed (16 × the patch limit): choose a larger size",
+                crate::budget::human_count(cells),
+                crate::budget::human_count(cell_limit)
             ),
         });
     }
@@ -228,10 +238,11 @@ fn check(scene: &Scene, options: &PatchOptions) -> Result<()> {
         return Err(Error::Option {
             option: "patch_size",
             problem: format!(
-                "{size} cuts the scene's {:.1} area units into about {estimate:.0} patches, more \
-                 than the {} allowed (the solve grows as the square): choose a larger size",
+                "{size} cuts the scene's {:.1} area units into about {} patches, more than the \
+                 {} allowed (the solve grows as the square): choose a larger size",
                 scene.total_area(),
-                options.max_patches
+                crate::budget::human_count(estimate),
+                crate::budget::human_count(options.max_patches as f64)
             ),
         });
     }

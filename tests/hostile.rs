@@ -1,0 +1,631 @@
+//! A hostile host: inputs that once aborted, hung or panicked the library, each run in a child
+//! process of this test binary (so an abort is caught, not suffered) under a 4 GiB
+//! address-space limit and a watchdog. Every case must end in a clear `Err` or a correct
+//! result, on every backend.
+
+mod common;
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::{camera, material, Builder};
+use glam::Vec3;
+use meshlight::lux::{enclosed, illuminance, LuxOptions};
+use meshlight::progress::Control;
+use meshlight::reference::{patch_radiosity, path_trace, PatchOptions, PathOptions};
+use meshlight::scene::{Grid, Mesh, SceneParts, SolverDefaults};
+use meshlight::visibility::{Hit, Ray, Segment};
+use meshlight::{Backend, Error, Options, RenderOptions, Scene, Visibility};
+
+/// The environment variable that tells a child which case it runs.
+const CASE: &str = "MESHLIGHT_HOSTILE_CASE";
+/// Address space a case may take: a case asking for more fails its allocation (an abort the
+/// parent sees) instead of swapping the machine.
+const ADDRESS_SPACE: u64 = 4 << 30;
+/// Seconds a case may take before it counts as a hang.
+const WATCHDOG: u64 = 60;
+
+/// Runs `body` in a child process (the parent) or runs it (the child).
+fn isolated(name: &str, body: impl FnOnce()) {
+    if std::env::var(CASE).as_deref() == Ok(name) {
+        body();
+        return;
+    }
+    let exe = std::env::current_exe().unwrap();
+    let limit = format!("--as={ADDRESS_SPACE}");
+    let args = [name, "--exact", "--nocapture", "--test-threads=1"];
+    let mut command = if Command::new("prlimit").arg("--version").output().is_ok() {
+        let mut c = Command::new("prlimit");
+        c.arg(limit).arg("--").arg(&exe).args(args);
+        c
+    } else {
+        let mut c = Command::new(&exe);
+        c.args(args);
+        c
+    };
+    let mut child = command
+        .env(CASE, name)
+        .env("RUST_BACKTRACE", "0")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(WATCHDOG) {
+            child.kill().ok();
+            panic!("{name}: still running after {WATCHDOG} s: a hang");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let output = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&output.stdout).to_string()
+        + &String::from_utf8_lossy(&output.stderr);
+    let text: String = text.lines().take(30).collect::<Vec<_>>().join("\n");
+    assert!(
+        status.success(),
+        "{name}: the child ended with {status} after {:.1} s:\n{text}",
+        start.elapsed().as_secs_f64()
+    );
+}
+
+/// A lit room, 2 × 2 × 2, with a point light: small enough to solve in a moment.
+fn room() -> Scene {
+    let mut b = Builder::default();
+    let white = b.material(material("white", 0.7, 0.0));
+    b.room(Vec3::ZERO, Vec3::splat(2.0), white, &[]);
+    b.point_lights.push(meshlight::scene::PointLight {
+        position: Vec3::splat(1.0),
+        intensity: Vec3::splat(2.0),
+    });
+    b.scene(camera(Vec3::new(1.0, 1.0, 1.9), Vec3::splat(1.0), 16))
+}
+
+fn quick() -> Options {
+    Options {
+        rounds: 1,
+        epsilon: Some(0.2),
+        ..Options::default()
+    }
+}
+
+fn go(_: &meshlight::Progress) -> Control {
+    Control::Continue
+}
+
+/// A scene of `triangles` with one material, a point light and a camera.
+fn scene_of(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> meshlight::Result<Scene> {
+    let n = triangles.len();
+    let parts = SceneParts {
+        mesh: Mesh {
+            positions,
+            triangles,
+            triangle_materials: vec![0; n],
+            materials: vec![material("white", 0.5, 0.0)],
+        },
+        point_lights: vec![meshlight::scene::PointLight {
+            position: Vec3::new(0.5, 2.0, 0.5),
+            intensity: Vec3::ONE,
+        }],
+        camera: camera(Vec3::new(0.5, 0.5, 3.0), Vec3::splat(0.5), 8),
+        two_sided: false,
+        solver: SolverDefaults::default(),
+    };
+    Scene::from_parts("hostile", parts)
+}
+
+/// Asserts an error and that its message mentions every word of `words`.
+fn refused<T: std::fmt::Debug>(case: &str, result: meshlight::Result<T>, words: &[&str]) {
+    match result {
+        Ok(value) => panic!("{case}: accepted: {value:?}"),
+        Err(e) => {
+            let text = e.to_string();
+            for w in words {
+                assert!(text.contains(w), "{case}: '{text}' does not mention '{w}'");
+            }
+            println!("{case}: {text}");
+        }
+    }
+}
+
+// --- Surface grouping: linear in the triangles whatever the mesh. ---
+
+#[test]
+fn ten_thousand_identical_triangles_group_in_bounded_time() {
+    isolated(
+        "ten_thousand_identical_triangles_group_in_bounded_time",
+        || {
+            let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Z];
+            let scene = scene_of(positions, vec![[0, 2, 1]; 10_000]).unwrap();
+            // Identical faces: one surface (they share edges, plane, facing and material).
+            assert_eq!(scene.surfaces().len(), 1);
+            assert_eq!(scene.triangles().len(), 10_000);
+        },
+    );
+}
+
+#[test]
+fn a_hundred_thousand_triangles_fanned_around_one_edge_group_in_bounded_time() {
+    isolated(
+        "a_hundred_thousand_triangles_fanned_around_one_edge_group_in_bounded_time",
+        || {
+            // Every triangle shares the edge (0,0,0)-(0,0,1) and turns by 2π / n about it:
+            // each in its own plane, so each its own surface.
+            let n = 100_000u32;
+            let mut positions = vec![Vec3::ZERO, Vec3::Z];
+            let mut triangles = Vec::new();
+            for i in 0..n {
+                let a = std::f32::consts::TAU * i as f32 / n as f32;
+                positions.push(Vec3::new(a.cos(), a.sin(), 0.5));
+                triangles.push([0, 1, i + 2]);
+            }
+            let t = Instant::now();
+            let scene = scene_of(positions, triangles).unwrap();
+            println!("fan of {n}: {:.2} s", t.elapsed().as_secs_f64());
+            assert_eq!(scene.surfaces().len(), n as usize);
+        },
+    );
+}
+
+#[test]
+fn an_obj_of_a_hundred_thousand_repeated_faces_loads() {
+    isolated("an_obj_of_a_hundred_thousand_repeated_faces_loads", || {
+        let dir = std::env::temp_dir().join(format!("meshlight-hostile-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut obj = std::fs::File::create(dir.join("f.obj")).unwrap();
+        writeln!(obj, "v 0 0 0\nv 1 0 0\nv 0 1 0").unwrap();
+        for _ in 0..100_000 {
+            writeln!(obj, "f 1 2 3").unwrap();
+        }
+        drop(obj);
+        std::fs::write(
+            dir.join("scene.toml"),
+            "obj = \"f.obj\"\n[[point_light]]\nposition = [0.2, 0.2, 1]\nintensity = [1, 1, 1]\n\
+             [camera]\nposition = [0.3, 0.3, 2]\nlook_at = [0.3, 0.3, 0]\nfov_y = 60\nwidth = 8\n\
+             height = 8\n",
+        )
+        .unwrap();
+        let scene = Scene::load(dir.join("scene.toml"));
+        std::fs::remove_dir_all(&dir).ok();
+        let scene = scene.unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(scene.surfaces().len(), 1);
+    });
+}
+
+// --- Allocations under the budget, refused before they are made. ---
+
+#[test]
+fn a_huge_camera_is_refused_before_its_image_is_allocated() {
+    isolated(
+        "a_huge_camera_is_refused_before_its_image_is_allocated",
+        || {
+            let mut scene = room();
+            let big = meshlight::scene::Camera {
+                width: 32_768,
+                height: 32_768,
+                ..*scene.camera()
+            };
+            // Either the camera or the render is refused; nothing is allocated for 10⁹ pixels.
+            if scene.set_camera(big).is_ok() {
+                let vis = Backend::Bvh.build(&scene).unwrap();
+                let s = meshlight::solve(&scene, vis.as_ref(), &quick(), &mut go).unwrap();
+                let r =
+                    meshlight::render(&scene, &s, vis.as_ref(), &RenderOptions::default(), &mut go);
+                refused("camera 32768²", r.map(|_| ()), &["budget"]);
+            }
+        },
+    );
+}
+
+#[test]
+fn a_huge_supersample_is_refused() {
+    isolated("a_huge_supersample_is_refused", || {
+        let scene = room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let s = meshlight::solve(&scene, vis.as_ref(), &quick(), &mut go).unwrap();
+        let options = RenderOptions {
+            supersample: 4096,
+            ..RenderOptions::default()
+        };
+        let r = meshlight::render(&scene, &s, vis.as_ref(), &options, &mut go);
+        refused("supersample 4096", r.map(|_| ()), &["supersample"]);
+    });
+}
+
+#[test]
+fn a_huge_pipeline_is_refused_or_bounded() {
+    isolated("a_huge_pipeline_is_refused_or_bounded", || {
+        let scene = room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            pipeline_capacity: 1 << 30,
+            ..quick()
+        };
+        let r = meshlight::solve(&scene, vis.as_ref(), &options, &mut go);
+        refused("pipeline 2³⁰", r.map(|_| ()), &["pipeline"]);
+    });
+}
+
+#[test]
+fn a_huge_grid_is_refused() {
+    isolated("a_huge_grid_is_refused", || {
+        let huge = Grid::new(
+            "huge",
+            Vec3::ZERO,
+            Vec3::X * 1e5,
+            Vec3::Z * 1e5,
+            None,
+            Some(1.0),
+        );
+        assert!(huge.is_err(), "a 10⁵ × 10⁵ grid was accepted");
+    });
+}
+
+// --- Loops a host waits on end, or hear Stop. ---
+
+#[test]
+fn a_tiny_zeta_ends_or_is_stopped() {
+    isolated("a_tiny_zeta_ends_or_is_stopped", || {
+        let scene = room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            zeta: 1e-5,
+            rounds: 2,
+            ..quick()
+        };
+        let start = Instant::now();
+        let mut last = Instant::now();
+        let mut longest_silence = Duration::ZERO;
+        let r = meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| {
+            longest_silence = longest_silence.max(last.elapsed());
+            last = Instant::now();
+            if start.elapsed() > Duration::from_secs(5) {
+                Control::Stop
+            } else {
+                Control::Continue
+            }
+        });
+        let took = start.elapsed();
+        println!(
+            "zeta 1e-5: {:.1} s, longest silence {longest_silence:?}",
+            took.as_secs_f64()
+        );
+        // Either it ends on its own (the darts are capped) or the Stop is heard promptly.
+        if let Ok(s) = &r {
+            assert_eq!(s.validate(), Ok(()));
+        }
+        assert!(took < Duration::from_secs(8), "{took:?}");
+        assert!(
+            longest_silence < Duration::from_secs(5),
+            "{longest_silence:?}"
+        );
+    });
+}
+
+// --- A backend that answers nonsense. ---
+
+/// A backend that answers every ray with a hit on a triangle the scene does not have.
+struct Liar(Box<dyn Visibility>);
+
+impl Visibility for Liar {
+    fn name(&self) -> &'static str {
+        "liar"
+    }
+    fn occluded(&self, segments: &[Segment], out: &mut [bool]) -> meshlight::Result<()> {
+        self.0.occluded(segments, out)
+    }
+    fn intersect(&self, rays: &[Ray], out: &mut [Option<Hit>]) -> meshlight::Result<()> {
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = Some(Hit {
+                t: 0.5 * (r.t_min + r.t_max.min(1.0)),
+                triangle: u32::MAX,
+            });
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn hits_on_triangles_the_scene_lacks_are_refused_everywhere() {
+    isolated(
+        "hits_on_triangles_the_scene_lacks_are_refused_everywhere",
+        || {
+            let mut scene = room();
+            let grid =
+                Grid::new("g", Vec3::new(0.1, 0.5, 0.1), Vec3::X, Vec3::Z, None, None).unwrap();
+            scene.add_grid(grid.clone()).unwrap();
+            for backend in Backend::available() {
+                let honest = backend.build(&scene).unwrap();
+                let liar = Liar(backend.build(&scene).unwrap());
+                let words = ["liar", "triangle 4294967295"];
+                refused("enclosed", enclosed(&scene, &liar, &grid), &words);
+                refused(
+                    "solve",
+                    meshlight::solve(&scene, &liar, &quick(), &mut go).map(|_| ()),
+                    &words,
+                );
+                let s = meshlight::solve(&scene, honest.as_ref(), &quick(), &mut go).unwrap();
+                let r = meshlight::render(&scene, &s, &liar, &RenderOptions::default(), &mut go);
+                refused("render", r.map(|_| ()), &words);
+                let lux = illuminance(&scene, &s, &liar, &grid, &LuxOptions::default(), &mut go);
+                // The direct light and gather trace segments only: the liar's rays are not
+                // asked, and the honest answer is fine.
+                if let Err(e) = lux {
+                    assert!(e.to_string().contains("liar"), "{e}");
+                }
+                let paths = PathOptions {
+                    spp: 2,
+                    ..PathOptions::default()
+                };
+                refused(
+                    "path_trace",
+                    path_trace(&scene, &liar, &paths, &mut go).map(|_| ()),
+                    &words,
+                );
+                let patches = PatchOptions {
+                    patch_size: 0.5,
+                    ..PatchOptions::default()
+                };
+                refused(
+                    "patch_radiosity",
+                    patch_radiosity(&scene, &liar, &patches, &mut go).map(|_| ()),
+                    &words,
+                );
+            }
+        },
+    );
+}
+
+/// A backend that panics on its first call.
+struct Panicky;
+
+impl Visibility for Panicky {
+    fn name(&self) -> &'static str {
+        "panicky"
+    }
+    fn occluded(&self, _: &[Segment], _: &mut [bool]) -> meshlight::Result<()> {
+        panic!("occluded exploded")
+    }
+    fn intersect(&self, _: &[Ray], _: &mut [Option<Hit>]) -> meshlight::Result<()> {
+        panic!("intersect exploded")
+    }
+}
+
+#[test]
+fn a_panicking_backend_is_named_in_the_error() {
+    isolated("a_panicking_backend_is_named_in_the_error", || {
+        let scene = room();
+        let r = meshlight::solve(&scene, &Panicky, &quick(), &mut go);
+        refused("solve", r.map(|_| ()), &["panicky", "exploded"]);
+        let honest = Backend::Bvh.build(&scene).unwrap();
+        let s = meshlight::solve(&scene, honest.as_ref(), &quick(), &mut go).unwrap();
+        let r = meshlight::render(&scene, &s, &Panicky, &RenderOptions::default(), &mut go);
+        let text = r.map(|_| ()).unwrap_err().to_string();
+        assert!(
+            text.contains("panicky") && text.contains("exploded"),
+            "{text}"
+        );
+        assert!(
+            !text.contains("solver"),
+            "a render failure worded as the solver's: {text}"
+        );
+    });
+}
+
+// --- Scale and solutions that do not fit. ---
+
+#[test]
+fn a_solution_of_another_size_does_not_render() {
+    isolated("a_solution_of_another_size_does_not_render", || {
+        let scene = room();
+        let bigger = scene.scaled(2.0).unwrap();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let s = meshlight::solve(&scene, vis.as_ref(), &quick(), &mut go).unwrap();
+        let vis2 = Backend::Bvh.build(&bigger).unwrap();
+        let r = meshlight::render(
+            &bigger,
+            &s,
+            vis2.as_ref(),
+            &RenderOptions::default(),
+            &mut go,
+        );
+        refused("render ×2", r.map(|_| ()), &["solution"]);
+    });
+}
+
+#[test]
+fn scenes_beyond_the_valid_scale_are_refused_and_those_within_it_agree() {
+    isolated(
+        "scenes_beyond_the_valid_scale_are_refused_and_those_within_it_agree",
+        || {
+            let scene = room();
+            let diagonal = scene.bounds().diagonal();
+            for s in [2.4e14f32, 1e-18, 1e-4] {
+                refused(&format!("× {s}"), scene.scaled(s).map(|_| ()), &["across"]);
+            }
+            // Far from the origin: 1e6 diagonals out.
+            let mut b = Builder::default();
+            let white = b.material(material("white", 0.7, 0.0));
+            let o = Vec3::new(1e6 * 3.5, 0.0, 0.0);
+            b.room(o, o + Vec3::splat(2.0), white, &[]);
+            let parts = SceneParts {
+                mesh: b.mesh,
+                point_lights: Vec::new(),
+                camera: camera(o + Vec3::ONE, o + Vec3::new(1.0, 1.0, -1e3), 8),
+                two_sided: false,
+                solver: SolverDefaults::default(),
+            };
+            refused(
+                "far out",
+                Scene::from_parts("far", parts).map(|_| ()),
+                &["from the origin"],
+            );
+            // Near the ends of the range the image is the same as at 1 (the same ε in
+            // diagonals): the range is one the results hold over.
+            let mean = |s: f32, backend: Backend| {
+                let scaled = scene.scaled(s).unwrap();
+                let vis = backend.build(&scaled).unwrap();
+                let options = Options {
+                    epsilon: Some(0.2 * s),
+                    ..quick()
+                };
+                let solved = meshlight::solve(&scaled, vis.as_ref(), &options, &mut go).unwrap();
+                let (image, _) = meshlight::render(
+                    &scaled,
+                    &solved,
+                    vis.as_ref(),
+                    &RenderOptions::default(),
+                    &mut go,
+                )
+                .unwrap();
+                image.mean()
+            };
+            let (lo, hi) = (
+                *meshlight::scene::SCENE_SIZE.start() / diagonal,
+                *meshlight::scene::SCENE_SIZE.end() / diagonal,
+            );
+            for backend in Backend::available() {
+                let at_one = mean(1.0, backend);
+                for s in [lo * 1.01, hi * 0.99] {
+                    let m = mean(s, backend);
+                    assert!(
+                        (m / at_one - 1.0).abs() < 1e-3,
+                        "{backend} × {s}: mean {m} against {at_one} at × 1"
+                    );
+                }
+            }
+        },
+    );
+}
+
+#[test]
+fn numbers_in_messages_have_sensible_digits() {
+    isolated("numbers_in_messages_have_sensible_digits", || {
+        let scene = room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            epsilon: Some(1e-12),
+            ..quick()
+        };
+        let e = meshlight::solve(&scene, vis.as_ref(), &options, &mut go).unwrap_err();
+        let text = e.to_string();
+        let longest = text
+            .split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max()
+            .unwrap_or(0);
+        assert!(longest <= 8, "a number of {longest} digits: {text}");
+        assert!(
+            matches!(e, Error::Budget { .. } | Error::Option { .. }),
+            "{e:?}"
+        );
+    });
+}
+
+// --- Options drawn at random from the extremes. ---
+
+/// splitmix64: a reproducible stream of choices without a dependency.
+struct Draw(u64);
+
+impl Draw {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn pick<T: Copy>(&mut self, values: &[T]) -> T {
+        values[(self.next() % values.len() as u64) as usize]
+    }
+}
+
+fn draw_f32(draw: &mut Draw) -> f32 {
+    draw.pick(&[f32::NAN, f32::INFINITY, -1.0, 0.0, 1e-30, 0.2, 8.0, 1e30])
+}
+
+#[test]
+fn options_drawn_from_the_extremes_end_in_a_result_or_an_error_and_hear_a_stop() {
+    isolated(
+        "options_drawn_from_the_extremes_end_in_a_result_or_an_error_and_hear_a_stop",
+        || {
+            let scene = room();
+            let vis = Backend::Bvh.build(&scene).unwrap();
+            let f32s = [f32::NAN, f32::INFINITY, -1.0, 0.0, 1e-30, 0.2, 8.0, 1e30];
+            let f64s = [
+                f64::NAN,
+                f64::INFINITY,
+                -1.0,
+                0.0,
+                1e-300,
+                1e-3,
+                0.05,
+                1.0,
+                1e300,
+            ];
+            let sizes = [0usize, 1, 2, 16, 1 << 20, usize::MAX];
+            let counts = [0u32, 1, 2, 16, 1000, u32::MAX];
+            let mut draw = Draw(2026);
+            let (mut ok, mut refused) = (0, 0);
+            for case in 0..120 {
+                // One to three fields at an extreme (or an ordinary value), the rest default:
+                // most cases then reach the solver rather than all being refused at once.
+                let mut options = Options {
+                    seed: draw.next(),
+                    ..Options::default()
+                };
+                for _ in 0..1 + draw.next() % 3 {
+                    match draw.next() % 15 {
+                        0 => {
+                            let e = draw_f32(&mut draw);
+                            options.epsilon = draw.pick(&[None, Some(e)]);
+                        }
+                        1 => options.alpha = draw.pick(&f32s),
+                        2 => options.zeta = draw.pick(&f32s),
+                        3 => options.rounds = draw.pick(&[0, 1, 2, 1000]),
+                        4 => options.light_samples = draw.pick(&counts),
+                        5 => options.tolerance = draw.pick(&f64s),
+                        6 => {
+                            options.max_shots = draw.pick(&[None, Some(0), Some(1), Some(u64::MAX)])
+                        }
+                        7 => options.max_samples = draw.pick(&sizes),
+                        8 => options.cluster_threshold = draw.pick(&f64s),
+                        9 => options.memory_budget = draw.pick(&sizes),
+                        10 => options.specular_depth = draw.pick(&counts),
+                        11 => options.specular_rays = draw.pick(&counts),
+                        12 => options.threads = draw.pick(&[0, 1, 2, usize::MAX]),
+                        13 => options.pipeline_capacity = draw.pick(&sizes),
+                        _ => options.exact_visibility = !options.exact_visibility,
+                    }
+                }
+                // Stop after 1 s: whatever the options, the call must then end promptly.
+                let start = Instant::now();
+                let r = meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| {
+                    if start.elapsed() > Duration::from_secs(1) {
+                        Control::Stop
+                    } else {
+                        Control::Continue
+                    }
+                });
+                let took = start.elapsed();
+                assert!(
+                    took < Duration::from_secs(3),
+                    "case {case}: {took:?}: {options:?}"
+                );
+                match r {
+                    Ok(s) => {
+                        assert_eq!(s.validate(), Ok(()), "case {case}: {options:?}");
+                        ok += 1;
+                    }
+                    Err(_) => refused += 1,
+                }
+            }
+            println!("{ok} solved, {refused} refused");
+            assert!(ok > 0 && refused > 0);
+        },
+    );
+}
