@@ -92,7 +92,8 @@ const fn case(
 const CASES: &[Case] = &[
     // TOML that does not parse, and unknown keys.
     case(In::Toml, "*", "obj = \"s.obj\"\n[camera\n", "scene.toml:2:", "unclosed table"),
-    case(In::Toml, "*", "obj = \"s.obj\"\n", "scene.toml", "missing field `camera`"),
+    case(In::Toml, "*", "obj = \"s.obj\"\n", "scene.toml:1", "no [camera]"),
+    case(In::Toml, "*", "two_sided = true\n", "scene.toml:1", "names no geometry"),
     case(In::Toml, "fov_y = 40.0", "fov_y = 40.0\nfocal = 3", "scene.toml:", "unknown field `focal`"),
     case(In::Toml, "", "\n[solver]\nepsilon = 0.1\nzeta_typo = 1\n", "scene.toml:", "unknown field `zeta_typo`"),
     // OBJ and MTL that do not parse.

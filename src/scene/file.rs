@@ -16,10 +16,11 @@ use crate::ies::Photometry;
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SceneToml {
-    obj: Spanned<String>,
+    obj: Option<Spanned<String>>,
+    gltf: Option<Spanned<String>>,
     #[serde(default)]
     two_sided: bool,
-    camera: Spanned<CameraToml>,
+    camera: Option<Spanned<CameraToml>>,
     #[serde(default)]
     point_light: Vec<Spanned<PointLightToml>>,
     #[serde(default)]
@@ -96,11 +97,30 @@ struct SolverToml {
     max_reflectance: Option<f32>,
 }
 
-/// What the scene file says, checked, with the OBJ path resolved.
+/// Where a scene's geometry comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum Geometry {
+    /// An OBJ file (with its MTL files).
+    Obj(PathBuf),
+    /// A glTF 2.0 file (`.gltf` or `.glb`).
+    Gltf(PathBuf),
+}
+
+impl Geometry {
+    /// The file named.
+    pub fn path(&self) -> &Path {
+        match self {
+            Geometry::Obj(p) | Geometry::Gltf(p) => p,
+        }
+    }
+}
+
+/// What the scene file says, checked, with the geometry's path resolved.
 pub(super) struct SceneFile {
-    pub obj: PathBuf,
+    pub geometry: Geometry,
     pub two_sided: bool,
-    pub camera: Camera,
+    /// The camera; an OBJ scene must give one, a glTF's may come from the file.
+    pub camera: Option<Camera>,
     pub point_lights: Vec<PointLight>,
     pub luminaires: Vec<Luminaire>,
     pub units: Units,
@@ -108,10 +128,29 @@ pub(super) struct SceneFile {
     pub solver: SolverDefaults,
     /// `[material.NAME]` overrides, in name order.
     pub overrides: Vec<Override>,
-    /// The `obj =` line.
+    /// The `obj =` (or `gltf =`) line.
     pub obj_line: usize,
     /// Comment lines of the scene file that name the OBJ file (how to make it, say).
     pub obj_notes: Vec<String>,
+}
+
+impl SceneFile {
+    /// A glTF read on its own, as if a scene file named it and nothing else.
+    pub fn of_gltf(path: &Path) -> SceneFile {
+        SceneFile {
+            geometry: Geometry::Gltf(path.to_path_buf()),
+            two_sided: false,
+            camera: None,
+            point_lights: Vec::new(),
+            luminaires: Vec::new(),
+            units: Units::default(),
+            grids: Vec::new(),
+            solver: SolverDefaults::default(),
+            overrides: Vec::new(),
+            obj_line: 1,
+            obj_notes: Vec::new(),
+        }
+    }
 }
 
 /// 1-based line of a byte offset.
@@ -217,19 +256,25 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         Error::scene(path, Some(line_of(text, span.start)), problem)
     };
 
-    let camera_span = parsed.camera.span();
-    let c = parsed.camera.into_inner();
-    let camera = Camera {
-        position: Vec3::from(c.position),
-        look_at: Vec3::from(c.look_at),
-        up: Vec3::from(c.up.unwrap_or([0.0, 1.0, 0.0])),
-        fov_y: c.fov_y,
-        width: c.width,
-        height: c.height,
+    let camera = match parsed.camera {
+        None => None,
+        Some(c) => {
+            let camera_span = c.span();
+            let c = c.into_inner();
+            let camera = Camera {
+                position: Vec3::from(c.position),
+                look_at: Vec3::from(c.look_at),
+                up: Vec3::from(c.up.unwrap_or([0.0, 1.0, 0.0])),
+                fov_y: c.fov_y,
+                width: c.width,
+                height: c.height,
+            };
+            if let Some(problem) = camera.problem() {
+                return Err(at(camera_span, problem));
+            }
+            Some(camera)
+        }
     };
-    if let Some(problem) = camera.problem() {
-        return Err(at(camera_span, problem));
-    }
 
     let mut point_lights = Vec::with_capacity(parsed.point_light.len());
     for light in parsed.point_light {
@@ -314,12 +359,36 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         })
         .collect();
 
-    let obj_span = parsed.obj.span();
-    let obj = parsed.obj.into_inner();
+    let (key, named) = match (parsed.obj, parsed.gltf) {
+        (Some(obj), None) => ("obj", obj),
+        (None, Some(gltf)) => ("gltf", gltf),
+        (Some(_), Some(gltf)) => {
+            return Err(at(
+                gltf.span(),
+                "the scene names both an obj and a gltf: give one of them".into(),
+            ))
+        }
+        (None, None) => {
+            return Err(Error::scene(
+                path,
+                Some(1),
+                "the scene names no geometry: give obj = \"FILE.obj\" or gltf = \"FILE.glb\"",
+            ))
+        }
+    };
+    let obj_span = named.span();
+    let obj = named.into_inner();
     if obj.trim().is_empty() {
         return Err(at(
             obj_span,
-            "obj is empty: it must name the OBJ file".into(),
+            format!("{key} is empty: it must name the geometry file"),
+        ));
+    }
+    if key == "obj" && camera.is_none() {
+        return Err(Error::scene(
+            path,
+            Some(1),
+            "the scene has no [camera] (an OBJ carries none)",
         ));
     }
     let name = Path::new(&obj).file_name().map(|n| n.to_string_lossy());
@@ -333,7 +402,11 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         })
         .unwrap_or_default();
     Ok(SceneFile {
-        obj: dir.join(&obj),
+        geometry: if key == "obj" {
+            Geometry::Obj(dir.join(&obj))
+        } else {
+            Geometry::Gltf(dir.join(&obj))
+        },
         two_sided: parsed.two_sided,
         camera,
         point_lights,

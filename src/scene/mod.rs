@@ -4,6 +4,7 @@
 
 mod camera;
 mod file;
+mod gltf;
 mod grid;
 mod luminaire;
 mod material;
@@ -366,7 +367,12 @@ impl Scene {
         options: &LoadOptions,
     ) -> Result<Scene> {
         let path = path.as_ref();
-        let file = file::read(files, path)?;
+        let file = if is_gltf(path) {
+            // A glTF on its own: geometry, camera, lights and materials all from the file.
+            file::SceneFile::of_gltf(path)
+        } else {
+            file::read(files, path)?
+        };
         let max_reflectance = match options.max_reflectance {
             Some(r) => match validate::max_reflectance(r) {
                 Some(problem) => {
@@ -383,23 +389,34 @@ impl Scene {
             max_reflectance,
             strict: options.strict,
         };
-        let (mesh, mut warnings) = obj::read(files, &file.obj, &rules).map_err(|e| match e {
-            // A generated OBJ not made yet: say what the scene file says about it.
-            Error::Read { path: obj, cause }
-                if cause.kind() == std::io::ErrorKind::NotFound && !file.obj_notes.is_empty() =>
-            {
-                Error::scene(
-                    path,
-                    Some(file.obj_line),
-                    format!(
-                        "{} not found; the scene file says: {}",
-                        obj.display(),
-                        file.obj_notes.join(" ")
-                    ),
-                )
+        let geometry_path = file.geometry.path().to_path_buf();
+        let mut point_lights = file.point_lights;
+        let mut camera = file.camera;
+        let (mesh, mut warnings) = match &file.geometry {
+            file::Geometry::Obj(obj) => {
+                Scene::read_obj(files, obj, &rules, &file.obj_notes, (path, file.obj_line))?
             }
-            e => e,
-        })?;
+            file::Geometry::Gltf(gltf_path) => {
+                let read = gltf::read(
+                    files,
+                    gltf_path,
+                    file.units,
+                    (max_reflectance, options.strict),
+                )?;
+                point_lights.extend(read.point_lights);
+                if camera.is_none() {
+                    camera = read.cameras.into_iter().next().map(|(_, c)| c);
+                }
+                (read.mesh, read.warnings)
+            }
+        };
+        let Some(camera) = camera else {
+            return Err(Error::scene(
+                &geometry_path,
+                None,
+                "it has no perspective camera, and no scene file gives a [camera]",
+            ));
+        };
         let mut mesh = mesh;
         overrides::apply(
             path,
@@ -410,18 +427,45 @@ impl Scene {
         )?;
         let parts = SceneParts {
             mesh,
-            point_lights: file.point_lights,
-            camera: file.camera,
+            point_lights,
+            camera,
             two_sided: file.two_sided,
             solver: file.solver,
         };
-        let mut scene = Scene::build(path, parts, &file.obj)?;
+        let mut scene = Scene::build(path, parts, &geometry_path)?;
         scene.luminaires = file.luminaires;
         scene.units = file.units;
         scene.grids = file.grids;
         warnings.append(&mut scene.warnings);
         scene.warnings = warnings;
         Ok(scene)
+    }
+
+    /// The OBJ of a scene file, a missing one explained by the scene file's comments on it.
+    fn read_obj(
+        files: &dyn Source,
+        obj_path: &Path,
+        rules: &obj::Rules,
+        notes: &[String],
+        (path, line): (&Path, usize),
+    ) -> Result<(Mesh, Vec<String>)> {
+        obj::read(files, obj_path, rules).map_err(|e| match e {
+            // A generated OBJ not made yet: say what the scene file says about it.
+            Error::Read { path: obj, cause }
+                if cause.kind() == std::io::ErrorKind::NotFound && !notes.is_empty() =>
+            {
+                Error::scene(
+                    path,
+                    Some(line),
+                    format!(
+                        "{} not found; the scene file says: {}",
+                        obj.display(),
+                        notes.join(" ")
+                    ),
+                )
+            }
+            e => e,
+        })
     }
 
     /// Builds a scene from parts a host program made; errors name `name`.
@@ -612,4 +656,10 @@ impl Scene {
         });
         points.chain(luminaires).collect()
     }
+}
+/// Whether a path names a glTF file (`.gltf` or `.glb`, any case).
+pub(crate) fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
