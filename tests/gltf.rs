@@ -172,3 +172,50 @@ fn a_scene_file_may_name_a_gltf_and_add_to_it() {
         .to_string();
     assert!(e.contains("dark.gltf") && e.contains("camera"), "{e}");
 }
+
+#[test]
+fn a_room_exported_from_blender_lights_as_cycles_renders_it() {
+    // tests/data/blender-room.glb: a cube room with a red box, a 100 W point light and a camera,
+    // made and exported by Blender 5.0.1 (`scripts/blender_room.py`). Cycles rendered the same
+    // file's view at 256 × 192, 256 spp without clamping or denoising: mean radiance 0.61280
+    // (`scripts/compare_with_cycles.py`). Blender writes the light as 100·683/4π cd: in a
+    // radiometric scene, 100/4π W/sr.
+    let scene = Scene::load(data("blender-room.glb")).unwrap();
+    let lights = scene.point_lights();
+    assert_eq!(lights.len(), 1);
+    let expected = 100.0 / (4.0 * std::f32::consts::PI);
+    assert!(
+        (lights[0].intensity / expected - Vec3::ONE)
+            .abs()
+            .max_element()
+            < 1e-4
+    );
+    // Blender exports every material double-sided: the cube's faces point out, and still
+    // reflect inside.
+    assert!(scene.surfaces().iter().all(|s| s.two_sided));
+    const CYCLES_MEAN: f64 = 0.61280;
+    for backend in Backend::available() {
+        let mut scene = scene.clone();
+        let camera = meshlight::scene::Camera {
+            width: 128,
+            height: 96,
+            ..*scene.camera()
+        };
+        scene.set_camera(camera).unwrap();
+        let vis = backend.build(&scene).unwrap();
+        let s = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |_| {
+            Control::Continue
+        })
+        .unwrap();
+        let (image, _) = meshlight::render(
+            &scene,
+            &s,
+            vis.as_ref(),
+            &RenderOptions::default(),
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
+        let ratio = image.mean() / CYCLES_MEAN;
+        assert!((ratio - 1.0).abs() < 0.01, "{backend}: {ratio}");
+    }
+}
