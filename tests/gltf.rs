@@ -219,3 +219,24 @@ fn a_room_exported_from_blender_lights_as_cycles_renders_it() {
         assert!((ratio - 1.0).abs() < 0.01, "{backend}: {ratio}");
     }
 }
+
+#[test]
+fn a_camera_is_chosen_by_name() {
+    use meshlight::scene::{Disk, LoadOptions};
+    let load = |path: std::path::PathBuf, camera: &str| {
+        let options = LoadOptions {
+            camera: Some(camera.into()),
+            ..LoadOptions::default()
+        };
+        Scene::load_with(&Disk, path, &options)
+    };
+    // The Blender export's camera is its object's name.
+    let scene = load(data("blender-room.glb"), "Camera").unwrap();
+    assert!((scene.camera().position - Vec3::new(-1.8, 1.6, 1.8)).length() < 1e-5);
+    let e = load(data("blender-room.glb"), "Kamera")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'Kamera'") && e.contains("Camera"), "{e}");
+    let e = load(shipped("cornell"), "Camera").unwrap_err().to_string();
+    assert!(e.contains("only glTF"), "{e}");
+}

@@ -83,7 +83,7 @@ fn white_written_as_one_is_lowered_with_one_warning() {
     assert_eq!(scene.materials()[0].kd, Vec3::splat(0.8));
     let options = LoadOptions {
         max_reflectance: Some(0.7),
-        strict: false,
+        ..LoadOptions::default()
     };
     let scene = load_with(OBJ, &mtl, &toml, &options).unwrap();
     assert_eq!(scene.materials()[0].kd, Vec3::splat(0.7));
@@ -93,8 +93,8 @@ fn white_written_as_one_is_lowered_with_one_warning() {
 fn strict_refuses_white_written_as_one_and_bad_limits_are_named() {
     let mtl = [("s.mtl", "newmtl white\nKd 1 1 1\n")];
     let strict = LoadOptions {
-        max_reflectance: None,
         strict: true,
+        ..LoadOptions::default()
     };
     let e = load_with(OBJ, &mtl, TOML, &strict).unwrap_err().to_string();
     assert!(e.starts_with("s.mtl:2: material 'white': Kd 1 1 1"), "{e}");
@@ -110,7 +110,7 @@ fn strict_refuses_white_written_as_one_and_bad_limits_are_named() {
     }
     let options = LoadOptions {
         max_reflectance: Some(1.0),
-        strict: false,
+        ..LoadOptions::default()
     };
     let e = load_with(OBJ, &mtl, TOML, &options)
         .unwrap_err()

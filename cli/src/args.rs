@@ -20,6 +20,10 @@ pub struct Args {
     /// [solver] max_reflectance, else 0.9).
     #[arg(long, global = true)]
     pub max_reflectance: Option<f32>,
+    /// The glTF camera to render from, by name (default: the scene file's [camera], else the
+    /// glTF's first).
+    #[arg(long, global = true, value_name = "NAME")]
+    pub camera: Option<String>,
 }
 
 /// Solver settings shared by `render` and `samples`.

@@ -35,6 +35,7 @@ fn main() -> ExitCode {
     let loading = LoadOptions {
         max_reflectance: args.max_reflectance,
         strict: args.strict,
+        camera: args.camera,
     };
     match run(args.command, &loading) {
         Ok(()) => ExitCode::SUCCESS,

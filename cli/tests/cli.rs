@@ -560,3 +560,31 @@ fn a_scene_without_light_is_refused_and_a_light_facing_the_ceiling_is_named() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_gltf_renders_on_its_own_from_the_camera_named() {
+    // Blender's export: geometry, materials, the point light and the camera "Camera" all from
+    // the file (512 × 384 from its aspect ratio), no scene file.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("room.exr");
+    let run = meshlight(&[
+        "render",
+        "tests/data/blender-room.glb",
+        "--camera",
+        "Camera",
+        "--epsilon",
+        "0.4",
+        "--rounds",
+        "0",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let stdout = text(&run.stdout);
+    assert!(stdout.contains("render 512x384"), "{stdout}");
+    assert!(out.exists());
+    let run = meshlight(&["info", "tests/data/blender-room.glb", "--camera", "Kamera"]);
+    assert!(!run.status.success());
+    let stderr = text(&run.stderr);
+    assert!(stderr.contains("no camera 'Kamera'"), "{stderr}");
+}

@@ -20,7 +20,7 @@ const EFFICACY: f32 = 683.0;
 /// What a glTF file holds that meshlight reads.
 pub(super) struct GltfScene {
     pub mesh: Mesh,
-    /// The cameras, by name (or "camera N"), in node order.
+    /// The cameras, by their node's name (else their own, else "camera N"), in node order.
     pub cameras: Vec<(String, Camera)>,
     pub point_lights: Vec<PointLight>,
     pub warnings: Vec<String>,
@@ -141,8 +141,10 @@ pub(super) fn read(
                     let aspect = p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0);
                     let width = 512u32;
                     let height = aspect.map_or(512, |a| ((512.0 / a).round() as u32).max(1));
-                    let name = camera
+                    // The node's name is what a modelling tool shows (Blender's object name).
+                    let name = node
                         .name()
+                        .or(camera.name())
                         .map_or_else(|| format!("camera {}", camera.index()), str::to_string);
                     out.cameras.push((
                         name,

@@ -136,13 +136,16 @@ pub struct SolverDefaults {
 pub const DEFAULT_MAX_REFLECTANCE: f32 = 0.9;
 
 /// How a scene file is read.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct LoadOptions {
     /// What a reflectance channel of exactly 1 is lowered to; overrides the scene file's
     /// `[solver] max_reflectance` (default [`DEFAULT_MAX_REFLECTANCE`]).
     pub max_reflectance: Option<f32>,
     /// A reflectance of exactly 1 is an error instead of being lowered.
     pub strict: bool,
+    /// The glTF camera to use, by name (else the scene file's `[camera]`, else the glTF's
+    /// first).
+    pub camera: Option<String>,
 }
 
 /// An axis-aligned box.
@@ -394,6 +397,15 @@ impl Scene {
         let mut camera = file.camera;
         let (mesh, mut warnings) = match &file.geometry {
             file::Geometry::Obj(obj) => {
+                if let Some(name) = &options.camera {
+                    return Err(Error::Option {
+                        option: "camera",
+                        problem: format!(
+                            "'{name}': only glTF files carry named cameras; {} is an OBJ scene",
+                            path.display()
+                        ),
+                    });
+                }
                 Scene::read_obj(files, obj, &rules, &file.obj_notes, (path, file.obj_line))?
             }
             file::Geometry::Gltf(gltf_path) => {
@@ -404,8 +416,30 @@ impl Scene {
                     (max_reflectance, options.strict),
                 )?;
                 point_lights.extend(read.point_lights);
-                if camera.is_none() {
-                    camera = read.cameras.into_iter().next().map(|(_, c)| c);
+                match &options.camera {
+                    Some(name) => {
+                        let Some((_, c)) = read.cameras.iter().find(|(n, _)| n == name) else {
+                            let names: Vec<&str> =
+                                read.cameras.iter().map(|(n, _)| n.as_str()).collect();
+                            return Err(Error::Option {
+                                option: "camera",
+                                problem: format!(
+                                    "{} has no camera '{name}' (its cameras: {})",
+                                    gltf_path.display(),
+                                    if names.is_empty() {
+                                        "none".to_string()
+                                    } else {
+                                        names.join(", ")
+                                    }
+                                ),
+                            });
+                        };
+                        camera = Some(*c);
+                    }
+                    None if camera.is_none() => {
+                        camera = read.cameras.into_iter().next().map(|(_, c)| c);
+                    }
+                    None => {}
                 }
                 (read.mesh, read.warnings)
             }
