@@ -4,11 +4,11 @@
 
 mod common;
 
-use common::shipped;
+use common::{shipped, solve_and_render};
 use glam::Vec3;
 use meshlight::metrics::compare;
 use meshlight::scene::{Kind, Units};
-use meshlight::{Backend, Control, Options, RenderOptions, Scene};
+use meshlight::{Backend, Options, Scene};
 
 fn cornell(file: &str) -> std::path::PathBuf {
     shipped("cornell").with_file_name(file)
@@ -28,22 +28,12 @@ fn image(scene: &mut Scene, backend: Backend) -> meshlight::Image {
         ..*scene.camera()
     };
     scene.set_camera(camera).unwrap();
-    let vis = backend.build(scene).unwrap();
     let options = Options {
         epsilon: Some(0.04 * scene.bounds().diagonal()),
         rounds: 1,
         ..Options::default()
     };
-    let s = meshlight::solve(scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
-    meshlight::render(
-        scene,
-        &s,
-        vis.as_ref(),
-        &RenderOptions::default(),
-        &mut |_| Control::Continue,
-    )
-    .unwrap()
-    .0
+    solve_and_render(scene, backend, options, true).1
 }
 
 #[test]
@@ -202,19 +192,7 @@ fn a_room_exported_from_blender_lights_as_cycles_renders_it() {
             ..*scene.camera()
         };
         scene.set_camera(camera).unwrap();
-        let vis = backend.build(&scene).unwrap();
-        let s = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |_| {
-            Control::Continue
-        })
-        .unwrap();
-        let (image, _) = meshlight::render(
-            &scene,
-            &s,
-            vis.as_ref(),
-            &RenderOptions::default(),
-            &mut |_| Control::Continue,
-        )
-        .unwrap();
+        let (_, image) = solve_and_render(&scene, backend, Options::default(), true);
         let ratio = image.mean() / CYCLES_MEAN;
         assert!((ratio - 1.0).abs() < 0.01, "{backend}: {ratio}");
     }

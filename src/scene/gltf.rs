@@ -71,7 +71,6 @@ pub(super) fn read(
     };
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     stack.reverse();
-    let mut triangles_seen = 0usize;
     while let Some((node, parent)) = stack.pop() {
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
@@ -129,7 +128,6 @@ pub(super) fn read(
                         .push(if mirrored { [t[0], t[2], t[1]] } else { t });
                     out.mesh.triangle_materials.push(m);
                 }
-                triangles_seen += indices.len() / 3;
             }
         }
         if let Some(camera) = node.camera() {
@@ -193,7 +191,7 @@ pub(super) fn read(
             stack.push((child, world));
         }
     }
-    if triangles_seen == 0 {
+    if out.mesh.triangles.is_empty() {
         return Err(fail("its scene has no triangles".into()));
     }
     if used_default {
