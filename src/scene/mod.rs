@@ -8,6 +8,7 @@ mod gltf;
 mod grid;
 mod luminaire;
 mod material;
+mod mtl;
 mod obj;
 mod overrides;
 mod source;
