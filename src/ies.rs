@@ -248,6 +248,18 @@ impl Photometry {
         })
     }
 
+    /// A distribution symmetric about its axis: candela `candela[i]` at γ = `vertical[i]`
+    /// (degrees, increasing from 0 to at most 180), none beyond the last angle.
+    pub(crate) fn symmetric(vertical: Vec<f64>, candela: Vec<f64>) -> Photometry {
+        Photometry {
+            vertical,
+            horizontal: vec![0.0],
+            candela,
+            absolute: true,
+            flux: std::sync::OnceLock::new(),
+        }
+    }
+
     /// Intensity (candela) towards horizontal angle `c` and vertical angle `gamma`, degrees:
     /// the file's symmetry applied, bilinear between its angles, 0 outside its γ range.
     pub fn intensity(&self, c: f64, gamma: f64) -> f64 {

@@ -97,7 +97,7 @@ impl DirectLight {
                     normal: surface.normal,
                     offset: surface.offset,
                     ke: scene.material_of(s).ke.as_dvec3(),
-                    reflects: scene.material_of(s).kd.max_element() > 0.0,
+                    reflects: scene.material_of(s).reflects_diffusely(),
                 }
             })
             .collect();

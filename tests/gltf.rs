@@ -80,17 +80,32 @@ fn nodes_lights_cameras_and_materials_come_across() {
     assert!((b.min - Vec3::new(1.0, 0.0, 1.0)).length() < 1e-6, "{b:?}");
     assert!((b.max - Vec3::new(3.0, 1.0, 3.0)).length() < 1e-6, "{b:?}");
     // The point light: 683 cd × colour (1, 0.5, 0.25) is 1 W/sr × colour in radiometric units,
-    // at its node (1, 1, 1) under (1, 0, 1). The spot is left out with a warning.
+    // at its node (1, 1, 1) under (1, 0, 1).
     assert_eq!(scene.units(), Units::Radiometric);
     let lights = scene.point_lights();
     assert_eq!(lights.len(), 1);
     assert!((lights[0].position - Vec3::new(2.0, 1.0, 2.0)).length() < 1e-6);
     assert!((lights[0].intensity - Vec3::new(1.0, 0.5, 0.25)).length() < 1e-6);
+    // The spot: 10 cd (10/683 W/sr) at (2, 1.5, 2), turned −90° about x to point down, cones
+    // 0.2 and 0.5 rad. Inside 0.2 rad the full intensity; at γ = 0.35 rad glTF's falloff,
+    // t = (cos 0.35 − cos 0.5) / (cos 0.2 − cos 0.5) = 0.60292, t² = 0.36352 (by hand); none
+    // beyond 0.5 rad.
+    let spot = &scene.luminaires()[0];
+    assert!((spot.position - Vec3::new(2.0, 1.5, 2.0)).length() < 1e-6);
+    assert!((spot.aim - Vec3::NEG_Y).length() < 1e-6, "{:?}", spot.aim);
+    let peak = 10.0 / 683.0;
+    let at = |gamma: f32| {
+        let dir = Vec3::new(gamma.sin(), -gamma.cos(), 0.0);
+        spot.tint.x * spot.candela_towards(dir) as f32
+    };
+    assert!((at(0.0) - peak).abs() < 1e-6 * peak);
+    assert!((at(0.15) - peak).abs() < 1e-6 * peak);
     assert!(
-        scene.warnings().iter().any(|w| w.contains("spot")),
-        "{:?}",
-        scene.warnings()
+        (at(0.35) / peak - 0.36352).abs() < 2e-3,
+        "{}",
+        at(0.35) / peak
     );
+    assert_eq!(at(0.55), 0.0);
     // The camera: at (3, 1, 5), looking down −z, 0.8 rad tall, twice as wide as tall.
     let c = scene.camera();
     assert!((c.position - Vec3::new(3.0, 1.0, 5.0)).length() < 1e-6);
@@ -199,6 +214,38 @@ fn a_room_exported_from_blender_lights_as_cycles_renders_it() {
 }
 
 #[test]
+fn blender_mesh_lights_and_spots_light_as_cycles_renders_them() {
+    // tests/data/blender-lamps.glb (`scripts/blender_lamps.py`): the same room lit by a 0.6 m
+    // emissive panel hanging in it (emission strength 10, which Blender's mesh lights give off
+    // from both faces) and a 200 W spot of 60° with blend 0.3 pointing down. Cycles, 512 spp at
+    // 256 × 192: mean radiance 0.36488 (228 s). The panel emits 2 × 0.36 m² × π × 10 =
+    // 22.62 W; the spot is 200/4π W/sr on its axis, as Blender writes it (10,870 cd).
+    let scene = Scene::load(data("blender-lamps.glb")).unwrap();
+    let area = scene.emitted_power().x - scene.luminaires()[0].flux().x;
+    assert!(
+        (area - 2.0 * 0.36 * std::f64::consts::PI * 10.0).abs() < 0.01,
+        "{area}"
+    );
+    let spot = &scene.luminaires()[0];
+    let axis = spot.tint.x * spot.candela_towards(spot.aim) as f32;
+    assert!((axis / (200.0 / (4.0 * std::f32::consts::PI)) - 1.0).abs() < 1e-4);
+    const CYCLES_MEAN: f64 = 0.36488;
+    for backend in Backend::available() {
+        let mut scene = scene.clone();
+        let camera = meshlight::scene::Camera {
+            width: 256,
+            height: 192,
+            ..*scene.camera()
+        };
+        scene.set_camera(camera).unwrap();
+        let (_, image) = solve_and_render(&scene, backend, Options::default(), true);
+        let ratio = image.mean() / CYCLES_MEAN;
+        eprintln!("{backend}: ours / Cycles {ratio:.4}");
+        assert!((ratio - 1.0).abs() < 0.01, "{backend}: {ratio}");
+    }
+}
+
+#[test]
 fn a_camera_is_chosen_by_name() {
     use meshlight::scene::{Disk, LoadOptions};
     let load = |path: std::path::PathBuf, camera: &str| {
@@ -217,4 +264,137 @@ fn a_camera_is_chosen_by_name() {
     assert!(e.contains("'Kamera'") && e.contains("Camera"), "{e}");
     let e = load(shipped("cornell"), "Camera").unwrap_err().to_string();
     assert!(e.contains("only glTF"), "{e}");
+}
+
+#[test]
+fn mutated_blender_glb_files_load_or_fail_cleanly_never_panic() {
+    // 4,000 mutants of the two Blender exports: bytes flipped, runs overwritten with 0 or 0xFF,
+    // the file cut short, and numbers in the JSON chunk replaced by 0, -1, 9e99 or 4294967295
+    // (padded, so the chunk's length holds and the mutant gets past the GLB header). Each
+    // loads or is an error; a panic fails the test and names the mutant.
+    use rand::{RngExt, SeedableRng};
+    let seeds = [
+        std::fs::read(shipped("blender-stripes").with_file_name("room.glb")).unwrap(),
+        std::fs::read(data("blender-room.glb")).unwrap(),
+    ];
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(20);
+    let (mut loaded, mut refused) = (0, 0);
+    for i in 0..4000 {
+        let mut bytes = seeds[i % 2].clone();
+        let json_end = 20 + u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        match i % 4 {
+            0 => {
+                for _ in 0..rng.random_range(1..8) {
+                    let at = rng.random_range(0..bytes.len());
+                    bytes[at] ^= 1 << rng.random_range(0..8);
+                }
+            }
+            1 => {
+                let at = rng.random_range(0..bytes.len());
+                let end = (at + rng.random_range(1..64)).min(bytes.len());
+                let fill = if rng.random_bool(0.5) { 0 } else { 0xFF };
+                bytes[at..end].fill(fill);
+            }
+            2 => bytes.truncate(rng.random_range(0..bytes.len())),
+            _ => {
+                let digits: Vec<usize> = (20..json_end)
+                    .filter(|&j| bytes[j].is_ascii_digit() && !bytes[j - 1].is_ascii_digit())
+                    .collect();
+                let at = digits[rng.random_range(0..digits.len())];
+                let end = (at..json_end)
+                    .find(|&j| !(bytes[j].is_ascii_digit() || bytes[j] == b'.'))
+                    .unwrap();
+                let choices: [&[u8]; 4] = [b"0", b"-1", b"9e99", b"4294967295"];
+                let with = choices[rng.random_range(0..4)];
+                if with.len() <= end - at {
+                    bytes[at..at + with.len()].copy_from_slice(with);
+                    bytes[at + with.len()..end].fill(b' ');
+                }
+            }
+        }
+        let files = meshlight::scene::Memory::default().with("x.glb", bytes);
+        let result = std::panic::catch_unwind(|| Scene::load_from(&files, "x.glb"));
+        match result {
+            Ok(Ok(scene)) => {
+                assert!(scene.bounds().diagonal().is_finite(), "mutant {i}");
+                loaded += 1;
+            }
+            Ok(Err(e)) => {
+                // Named, and found by our checks, not by a panic inside the gltf crate.
+                let e = e.to_string();
+                assert!(e.contains("x.glb"), "mutant {i}: {e}");
+                assert!(!e.contains("glTF reader failed"), "mutant {i}: {e}");
+                refused += 1;
+            }
+            Err(_) => panic!("mutant {i} panicked"),
+        }
+    }
+    // Both outcomes happen: the mutations reach the reader and not only its first check.
+    assert!(
+        loaded > 100 && refused > 100,
+        "{loaded} loaded, {refused} refused"
+    );
+}
+
+#[test]
+fn a_double_sided_emitter_lights_both_halves_of_a_room() {
+    // A 0.5 m square lamp (Ke 1) level in the middle of a closed 2 m cube of Kd 0.5, two-sided
+    // (glTF's doubleSided, as Blender writes it; here the library's `two_sided`): it emits
+    // 2 × 0.25 m² × π W, twice a one-sided lamp's, and by symmetry the floor and the ceiling
+    // get the same light. Both backends, meshless against the path tracer.
+    let build = |two_sided: bool| {
+        let mut b = common::Builder::default();
+        let wall = b.material(common::material("wall", 0.5, 0.0));
+        let mut lamp = common::material("lamp", 0.0, 1.0);
+        lamp.two_sided = two_sided;
+        let lamp = b.material(lamp);
+        b.room(Vec3::ZERO, Vec3::splat(2.0), wall, &[]);
+        let (lo, hi) = (0.75, 1.25);
+        b.quad(
+            [
+                Vec3::new(lo, 1.0, lo),
+                Vec3::new(hi, 1.0, lo),
+                Vec3::new(hi, 1.0, hi),
+                Vec3::new(lo, 1.0, hi),
+            ],
+            lamp,
+        );
+        b.scene(common::camera(
+            Vec3::new(1.0, 1.0, 0.05),
+            Vec3::new(1.0, 1.0, 2.0),
+            24,
+        ))
+    };
+    let (one, two) = (build(false), build(true));
+    let quarter_pi = 0.25 * std::f64::consts::PI;
+    assert!((one.emitted_power().x - quarter_pi).abs() < 1e-6);
+    assert!((two.emitted_power().x - 2.0 * quarter_pi).abs() < 1e-5);
+    for backend in common::backends() {
+        let (solution, image) = solve_and_render(&two, backend, Options::default(), true);
+        let s = solution.samples();
+        let mean_on = |y: f32, ny: f32| {
+            let ks: Vec<usize> = (0..s.len())
+                .filter(|&k| (s.position()[k].y - y).abs() < 1e-3 && s.normal()[k].y == ny)
+                .collect();
+            ks.iter().map(|&k| solution.irradiance()[k].x).sum::<f64>() / ks.len() as f64
+        };
+        let (floor, ceiling) = (mean_on(0.0, 1.0), mean_on(2.0, -1.0));
+        assert!(
+            floor > 0.0 && (floor / ceiling - 1.0).abs() < 0.02,
+            "{backend:?}: floor {floor}, ceiling {ceiling}"
+        );
+        let vis = backend.build(&two).unwrap();
+        let traced = meshlight::reference::path_trace(
+            &two,
+            vis.as_ref(),
+            &meshlight::reference::PathOptions {
+                spp: 512,
+                ..Default::default()
+            },
+            &mut |_| meshlight::Control::Continue,
+        )
+        .unwrap();
+        let error = compare(&image, &traced.image).unwrap();
+        assert!(error.bias.abs() < 0.02, "{backend:?}: {error:?}");
+    }
 }

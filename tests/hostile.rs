@@ -106,6 +106,7 @@ fn scene_of(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> meshlight::Result
             triangles,
             triangle_materials: vec![0; n],
             materials: vec![material("white", 0.5, 0.0)],
+            texcoords: Vec::new(),
         },
         point_lights: vec![meshlight::scene::PointLight {
             position: Vec3::new(0.5, 2.0, 0.5),

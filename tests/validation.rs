@@ -284,6 +284,7 @@ fn host_built_scenes_are_checked_too() {
             triangles: vec![[0, 1, 2]],
             triangle_materials: vec![0],
             materials: vec![Material::diffuse("m", Vec3::splat(kd), Vec3::ZERO)],
+            texcoords: Vec::new(),
         },
         point_lights: vec![],
         camera: Camera {

@@ -560,8 +560,9 @@ impl Tracer<'_> {
             return self.scatter(index, path, hit, distance, queue);
         }
 
-        // What this side reflects: fronts with Kd, backs only of two-sided surfaces.
-        let kd = material.kd.as_dvec3();
+        // What this side reflects: fronts with Kd (or the texel there), backs only of
+        // two-sided surfaces.
+        let kd = scene.reflectance_at(hit.triangle, x).as_dvec3();
         if kd.max_element() <= 0.0 || !(front || surface.two_sided) {
             return false;
         }
@@ -750,7 +751,7 @@ impl Tracer<'_> {
         };
         let d = dir.as_dvec3().normalize();
         let kd = if front || surface.two_sided {
-            material.kd.as_dvec3()
+            scene.reflectance_at(hit.triangle, x).as_dvec3()
         } else {
             DVec3::ZERO
         };

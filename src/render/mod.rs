@@ -415,6 +415,9 @@ struct Pending {
     normal: Vec3,
     /// Whether its direct light is traced (else interpolated with the rest).
     traced: bool,
+    /// The reflectance at the hit, on a textured surface (its samples then show their light per
+    /// unit reflectance).
+    texel: Option<Vec3>,
     /// The seed of its shadow rays.
     id: u32,
 }
@@ -435,11 +438,24 @@ impl<'a> Shader<'a> {
             _ => None,
         };
         // What sample k shows: its radiance B/π, or its irradiance; without its direct light
-        // when that is traced at the hits.
+        // when that is traced at the hits. On a textured surface, its reflected radiance per
+        // unit reflectance: each hit multiplies it by the texel it sees and adds the emission.
         let shown = |k: usize, direct: glam::DVec3| match options.quantity {
             Quantity::Radiance => {
                 let rho = crate::solver::reflectance_of(scene, s, k);
-                (solution.radiosity[k] - rho * direct) / std::f64::consts::PI
+                let reflected = solution.radiosity[k] - rho * direct;
+                if scene.is_textured(crate::sampling::surface_of(s.side[k])) {
+                    let e = crate::solver::emission_of(scene, s, k);
+                    let per_unit =
+                        |b: f64, e: f64, rho: f64| if rho > 0.0 { (b - e) / rho } else { 0.0 };
+                    glam::DVec3::new(
+                        per_unit(reflected.x, e.x, rho.x),
+                        per_unit(reflected.y, e.y, rho.y),
+                        per_unit(reflected.z, e.z, rho.z),
+                    ) / std::f64::consts::PI
+                } else {
+                    reflected / std::f64::consts::PI
+                }
             }
             Quantity::Irradiance => solution.irradiance[k] - direct,
         };
@@ -475,6 +491,14 @@ impl<'a> Shader<'a> {
         }
     }
 
+    /// The reflectance at a hit on a textured surface; `None` elsewhere.
+    fn texel(&self, triangle: u32, point: Vec3) -> Option<Vec3> {
+        let surface = self.scene.triangles[triangle as usize].surface;
+        self.scene
+            .is_textured(surface)
+            .then(|| self.scene.reflectance_at(triangle, point))
+    }
+
     /// Shades a batch of rays: (radiance, side seen or u32::MAX). Ray i seeds its shadow rays
     /// with id `first_id + i`. Returns visibility queries.
     fn shade(&self, rays: &[Ray], first_id: u32, out: &mut [(Vec3, u32)]) -> Result<u64> {
@@ -492,6 +516,7 @@ impl<'a> Shader<'a> {
                     point: Vec3::ZERO,
                     normal: Vec3::ZERO,
                     traced: true,
+                    texel: None,
                     id: 0,
                 });
                 continue;
@@ -513,6 +538,7 @@ impl<'a> Shader<'a> {
                     point,
                     normal: tri.normal,
                     traced: true,
+                    texel: None,
                     id: 0,
                 });
                 continue;
@@ -524,6 +550,7 @@ impl<'a> Shader<'a> {
                 point,
                 normal,
                 traced: true,
+                texel: self.texel(triangle, point),
                 id: first_id.wrapping_add(pending.len() as u32),
             });
         }
@@ -584,7 +611,18 @@ impl<'a> Shader<'a> {
                     } else {
                         Vec3::ZERO
                     };
-                    interpolated + *direct
+                    match p.texel {
+                        Some(rho) if self.quantity == Quantity::Radiance => {
+                            let material = self.scene.material_of(surface_of(p.side));
+                            let emitted = if crate::sampling::is_back(p.side) {
+                                Vec3::ZERO
+                            } else {
+                                material.ke
+                            };
+                            rho * interpolated + emitted + *direct
+                        }
+                        _ => interpolated + *direct,
+                    }
                 }
             });
         }
@@ -612,7 +650,8 @@ impl<'a> Shader<'a> {
             let e = arrival.irradiance;
             shown[i] = match self.quantity {
                 Quantity::Radiance => {
-                    let rho = self.scene.material_of(surface_of(pending[i].side)).kd;
+                    let kd = || self.scene.material_of(surface_of(pending[i].side)).kd;
+                    let rho = pending[i].texel.unwrap_or_else(kd);
                     rho * e.as_vec3() / std::f32::consts::PI
                 }
                 Quantity::Irradiance => e.as_vec3(),

@@ -127,6 +127,7 @@ impl Shader<'_> {
                             point,
                             normal,
                             traced: b.traced,
+                            texel: self.texel(hit.triangle, point),
                             id: b.id,
                         },
                         b.origin,

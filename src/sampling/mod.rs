@@ -6,6 +6,7 @@ pub mod adaptive;
 pub(crate) mod cover;
 pub mod obstruction;
 pub mod poisson;
+pub(crate) mod reflectance;
 pub mod surface_map;
 
 use glam::{Vec2, Vec3};
@@ -38,7 +39,7 @@ pub fn is_back(side: Side) -> bool {
 pub fn reflecting_sides(scene: &Scene) -> Vec<Side> {
     let mut sides = Vec::new();
     for (i, s) in scene.surfaces.iter().enumerate() {
-        if scene.materials[s.material as usize].kd.max_element() > 0.0 {
+        if scene.materials[s.material as usize].reflects_diffusely() {
             sides.push(side_of(i as u32, false));
             if s.two_sided {
                 sides.push(side_of(i as u32, true));
@@ -78,6 +79,9 @@ pub struct Samples {
     pub(crate) cells: Vec<AreaCell>,
     /// The adaptive round in which each sample was added (0 = initial Poisson disk).
     pub(crate) round: Vec<u16>,
+    /// Each sample's diffuse reflectance when the scene has textures (see
+    /// [`reflectance::means`]); empty otherwise, and then each sample's is its material's Kd.
+    pub(crate) reflectance: Vec<Vec3>,
 }
 
 impl Samples {
@@ -163,6 +167,7 @@ impl Samples {
             + vec_bytes(&self.share_start)
             + vec_bytes(&self.cells)
             + vec_bytes(&self.round)
+            + vec_bytes(&self.reflectance)
     }
 
     /// Total area of the samples of each of `sides` sides (index: side id, `2 × surface` for

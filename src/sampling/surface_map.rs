@@ -154,14 +154,28 @@ impl SurfaceMap {
 
     /// Whether a 2D point lies on the surface (inside one of its triangles, edges included).
     pub fn contains(&self, p: Vec2) -> bool {
+        self.triangle_at(p).is_some()
+    }
+
+    /// The triangle (index among the surface's) a 2D point lies in, edges included.
+    pub fn triangle_at(&self, p: Vec2) -> Option<usize> {
         if p.cmplt(self.min).any() || p.cmpgt(self.max).any() {
-            return false;
+            return None;
         }
         let (x, y) = self.cell_of(p);
         let c = y * self.nx + x;
         self.entries[self.starts[c] as usize..self.starts[c + 1] as usize]
             .iter()
-            .any(|&t| inside(&self.triangles[t as usize], p))
+            .find(|&&t| inside(&self.triangles[t as usize], p))
+            .map(|&t| t as usize)
+    }
+
+    /// The triangle whose centre is nearest a 2D point (for points just off the surface).
+    pub fn nearest_triangle(&self, p: Vec2) -> usize {
+        let distance = |t: &[Vec2; 3]| ((t[0] + t[1] + t[2]) / 3.0).distance_squared(p);
+        (0..self.triangles.len())
+            .min_by(|&a, &b| distance(&self.triangles[a]).total_cmp(&distance(&self.triangles[b])))
+            .unwrap_or(0)
     }
 }
 

@@ -2,7 +2,11 @@
 //! diffuse reflectance and emission, and what it does with light beyond diffuse reflection —
 //! a mirror or a glossy GGX lobe, or smooth glass.
 
+use std::sync::Arc;
+
 use glam::Vec3;
+
+use super::Texture;
 
 /// A material: diffuse reflectance Kd, Lambertian emission Ke, and its kind.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,6 +23,9 @@ pub struct Material {
     pub kind: Kind,
     /// Whether it reflects on both sides whatever the scene's `two_sided` says.
     pub two_sided: bool,
+    /// A diffuse-reflectance texture (`map_Kd`, glTF's base colour texture): where a face has
+    /// texture coordinates its reflectance is Kd × the texel; elsewhere Kd.
+    pub texture: Option<Arc<Texture>>,
 }
 
 /// What a material does with light beyond Lambertian reflection.
@@ -71,7 +78,14 @@ impl Material {
             ke,
             kind: Kind::Diffuse,
             two_sided: false,
+            texture: None,
         }
+    }
+
+    /// Whether it reflects light diffusely anywhere: Kd, or its texture, above 0.
+    pub fn reflects_diffusely(&self) -> bool {
+        let texture = self.texture.as_ref().map_or(Vec3::ZERO, |t| t.mean());
+        self.kd.max_element() > 0.0 || (self.kd * texture).max_element() > 0.0
     }
 
     /// Whether faces of this material emit light.

@@ -13,12 +13,14 @@ mod obj;
 mod overrides;
 mod source;
 mod surfaces;
+mod texture;
+mod two_sided;
 mod validate;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 use crate::error::{Error, Result};
 pub use camera::Camera;
@@ -26,6 +28,7 @@ pub use grid::{Grid, MAX_GRID_POINTS};
 pub use luminaire::{luminance, Luminaire, PointSource};
 pub use material::{roughness_from_ns, Kind, Material};
 pub use source::{Disk, Memory, Source};
+pub use texture::{srgb_to_linear, Texture, MAX_TEXTURE_SIDE};
 pub use validate::{MAX_OFFSET_IN_DIAGONALS, SCENE_SIZE};
 
 /// A triangle of the scene, after degenerate ones were dropped.
@@ -179,6 +182,18 @@ impl Bounds {
     }
 }
 
+/// The texture coordinates of a point of triangle `t` whose corners have `uv`: barycentric
+/// weights from the point's projection on the triangle's plane.
+pub(crate) fn texture_point(t: &Triangle, uv: &[Vec2; 3], point: Vec3) -> Vec2 {
+    let [a, b, c] = t.vertices;
+    let (e1, e2, d) = (b - a, c - a, point - a);
+    let n = e1.cross(e2);
+    let inv = 1.0 / n.length_squared();
+    let wb = d.cross(e2).dot(n) * inv;
+    let wc = e1.cross(d).dot(n) * inv;
+    uv[0] + (uv[1] - uv[0]) * wb + (uv[2] - uv[0]) * wc
+}
+
 /// Triangle geometry with a material per triangle: what an OBJ file holds, or what a host
 /// program hands over.
 #[derive(Clone, Debug, Default)]
@@ -191,6 +206,10 @@ pub struct Mesh {
     pub triangle_materials: Vec<u32>,
     /// The materials.
     pub materials: Vec<Material>,
+    /// Texture coordinates of each triangle's corners (image coordinates: (0, 0) the image's
+    /// top-left, v downwards), for triangles whose material has a texture: empty, or one entry
+    /// per triangle (`None` where a triangle has none).
+    pub texcoords: Vec<Option<[Vec2; 3]>>,
 }
 
 /// Everything a scene is made of, before validation and surface grouping.
@@ -218,6 +237,9 @@ pub struct Scene {
     pub(crate) materials: Vec<Material>,
     /// Triangles, ordered so that each surface's triangles are contiguous.
     pub(crate) triangles: Vec<Triangle>,
+    /// Texture coordinates of each triangle (see [`Mesh::texcoords`]): empty when no
+    /// triangle has any.
+    pub(crate) texcoords: Vec<Option<[Vec2; 3]>>,
     /// Planar surfaces.
     pub(crate) surfaces: Vec<Surface>,
     /// Point lights.
@@ -395,6 +417,7 @@ impl Scene {
         };
         let geometry_path = file.geometry.path().to_path_buf();
         let mut point_lights = file.point_lights;
+        let mut luminaires = file.luminaires;
         let mut camera = file.camera;
         let (mesh, mut warnings) = match &file.geometry {
             file::Geometry::Obj(obj) => {
@@ -410,13 +433,25 @@ impl Scene {
                 Scene::read_obj(files, obj, &rules, &file.obj_notes, (path, file.obj_line))?
             }
             file::Geometry::Gltf(gltf_path) => {
-                let read = gltf::read(
-                    files,
-                    gltf_path,
-                    file.units,
-                    (max_reflectance, options.strict),
-                )?;
+                // The gltf crate is trusted with hostile files only behind a catch: a panic in
+                // it is an error naming the file, not an abort of the host.
+                let read = crate::parallel::caught(|| {
+                    gltf::read(
+                        files,
+                        gltf_path,
+                        file.units,
+                        (max_reflectance, options.strict),
+                    )
+                })
+                .unwrap_or_else(|panic| {
+                    Err(Error::scene(
+                        gltf_path,
+                        None,
+                        format!("the glTF reader failed on it ({panic})"),
+                    ))
+                })?;
                 point_lights.extend(read.point_lights);
+                luminaires.extend(read.luminaires);
                 match &options.camera {
                     Some(name) => {
                         let Some((_, c)) = read.cameras.iter().find(|(n, _)| n == name) else {
@@ -468,7 +503,7 @@ impl Scene {
             solver: file.solver,
         };
         let mut scene = Scene::build(path, parts, &geometry_path)?;
-        scene.luminaires = file.luminaires;
+        scene.luminaires = luminaires;
         scene.units = file.units;
         scene.grids = file.grids;
         warnings.append(&mut scene.warnings);
@@ -520,6 +555,13 @@ impl Scene {
             solver,
         } = parts;
         let mut warnings = Vec::new();
+        let mut mesh = mesh;
+        if two_sided::any(&mesh) {
+            let diagonal = two_sided::diagonal(&mesh);
+            if diagonal.is_finite() && diagonal > 0.0 {
+                two_sided::split(&mut mesh, diagonal);
+            }
+        }
         let (kept, dropped) = surfaces::drop_degenerate(&mesh);
         if dropped > 0 {
             warnings.push(format!(
@@ -539,12 +581,13 @@ impl Scene {
         if let Some(problem) = validate::extent(&bounds) {
             return Err(Error::scene(geometry_path, None, problem));
         }
-        let (triangles, surfaces) =
+        let (triangles, surfaces, texcoords) =
             surfaces::group(&kept, &mesh.materials, two_sided, bounds.diagonal());
         Ok(Scene {
             path: path.to_path_buf(),
             materials: mesh.materials,
             triangles,
+            texcoords,
             surfaces,
             point_lights,
             luminaires: Vec::new(),
@@ -653,6 +696,31 @@ impl Scene {
     /// The material of a surface (`surface` below `surfaces().len()`).
     pub(crate) fn material_of(&self, surface: u32) -> &Material {
         &self.materials[self.surfaces[surface as usize].material as usize]
+    }
+
+    /// Texture coordinates of each triangle (see [`Mesh::texcoords`]): empty when no
+    /// triangle has any.
+    pub fn texcoords(&self) -> &[Option<[Vec2; 3]>] {
+        &self.texcoords
+    }
+
+    /// Whether a surface's material has a texture (its reflectance varies over it).
+    pub(crate) fn is_textured(&self, surface: u32) -> bool {
+        self.material_of(surface).texture.is_some()
+    }
+
+    /// The diffuse reflectance at a point of a triangle: Kd × the texel there where the
+    /// triangle's material has a texture and the triangle has coordinates, else Kd.
+    pub(crate) fn reflectance_at(&self, triangle: u32, point: Vec3) -> Vec3 {
+        let t = &self.triangles[triangle as usize];
+        let material = self.material_of(t.surface);
+        match (&material.texture, self.texcoords.get(triangle as usize)) {
+            (Some(texture), Some(Some(uv))) => {
+                material.kd * texture.at(texture_point(t, uv, point))
+            }
+            (Some(texture), _) => material.kd.min(Vec3::splat(texture.bound())),
+            _ => material.kd,
+        }
     }
 
     /// Total area of all triangles.

@@ -5,15 +5,19 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
 
 use super::obj::{read_text, Rules};
 use super::validate::{self, MaterialField};
-use super::{Kind, Material};
+use super::{Kind, Material, Texture};
 use crate::error::{Error, Result};
 
 /// An MTL file reduced to `newmtl`, `Kd` and `Ke`, with where each material's lines are.
 pub(super) struct MtlLibrary {
+    /// What reading it found worth saying (ignored `map_Kd` options).
+    pub warnings: Vec<String>,
     pub path: PathBuf,
     /// The text tobj reads: `newmtl`, `Kd` and `Ke` only, at their lines.
     pub text: String,
@@ -34,13 +38,56 @@ struct MtlLines {
     ni: Option<(f32, usize)>,
     tf: Option<(Vec3, usize)>,
     illum: Option<(u32, usize)>,
+    map_kd: Option<MapKd>,
 }
+
+/// A `map_Kd` statement: the file and the options read from before it.
+pub(super) struct MapKd {
+    file: String,
+    line: usize,
+    /// `-s`: texture coordinates are scaled by it, then `-o` added (u and v; w is unused).
+    scale: Vec2,
+    offset: Vec2,
+}
+
+/// How a material's OBJ texture coordinates become image coordinates: `-s` and `-o` from its
+/// `map_Kd`, then v flipped (OBJ's v runs up the image).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct UvTransform {
+    pub scale: Vec2,
+    pub offset: Vec2,
+}
+
+impl UvTransform {
+    /// The image coordinates of OBJ texture coordinates `vt`.
+    pub fn apply(&self, vt: Vec2) -> Vec2 {
+        let uv = vt * self.scale + self.offset;
+        Vec2::new(uv.x, 1.0 - uv.y)
+    }
+}
+
+/// Options `map_Kd` may carry before the file name, with how many values each takes; only
+/// `-s` and `-o` change what meshlight shows, the others are ignored with a warning.
+const MAP_OPTIONS: [(&str, usize); 11] = [
+    ("-blendu", 1),
+    ("-blendv", 1),
+    ("-bm", 1),
+    ("-boost", 1),
+    ("-cc", 1),
+    ("-clamp", 1),
+    ("-imfchan", 1),
+    ("-mm", 2),
+    ("-texres", 1),
+    ("-o", 3),
+    ("-s", 3),
+];
 
 pub(super) fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibrary> {
     let text = read_text(files, path)?;
     let mut out = String::with_capacity(text.len());
     let mut materials: Vec<MtlLines> = Vec::new();
     let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut warnings = Vec::new();
     for (i, raw) in text.split('\n').enumerate() {
         let line = i + 1;
         let fail = |problem: String| Err(Error::scene(path, Some(line), problem));
@@ -68,6 +115,7 @@ pub(super) fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibr
                     ni: None,
                     tf: None,
                     illum: None,
+                    map_kd: None,
                 });
                 out.push_str("newmtl ");
                 out.push_str(name);
@@ -162,6 +210,15 @@ pub(super) fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibr
                 }
                 *slot = Some((value, line));
             }
+            Some("map_Kd") => {
+                let Some(current) = materials.last_mut() else {
+                    return fail("map_Kd before any newmtl".into());
+                };
+                let name = current.name.clone();
+                let map = map_kd(&name, words.collect(), line, path, &mut warnings)
+                    .map_err(|problem| Error::scene(path, Some(line), problem))?;
+                current.map_kd = Some(map);
+            }
             Some("illum") => {
                 let Some(current) = materials.last_mut() else {
                     return fail("illum before any newmtl".into());
@@ -181,6 +238,7 @@ pub(super) fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibr
         out.push('\n');
     }
     Ok(MtlLibrary {
+        warnings,
         path: path.to_path_buf(),
         text: out,
         materials,
@@ -188,12 +246,16 @@ pub(super) fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibr
 }
 
 /// Our materials from tobj's, checked, each error at its MTL file and line.
+/// Also returns, per material, how its texture coordinates map onto its texture (`None`
+/// without one).
 pub(super) fn materials_from(
+    files: &dyn super::Source,
     loaded: &[tobj::Material],
     libraries: &[MtlLibrary],
     rules: &Rules,
     warnings: &mut Vec<String>,
-) -> Result<Vec<Material>> {
+) -> Result<(Vec<Material>, Vec<Option<UvTransform>>)> {
+    let mut transforms = Vec::with_capacity(loaded.len());
     let lines: Vec<(&Path, &MtlLines)> = libraries
         .iter()
         .flat_map(|l| l.materials.iter().map(move |m| (l.path.as_path(), m)))
@@ -227,8 +289,22 @@ pub(super) fn materials_from(
             t.diffuse.map(Vec3::from).unwrap_or(Vec3::ZERO),
             t.emissive.map(Vec3::from).unwrap_or(Vec3::ZERO),
         );
+        let transform = at.map_kd.as_ref().and_then(|map| {
+            let has_kd = at.kd_line.is_some();
+            texture_of(
+                files,
+                path,
+                map,
+                &mut material,
+                has_kd,
+                rules.max_reflectance,
+                warnings,
+            )
+        });
+        transforms.push(transform);
         let kd = material.kd;
-        if kd.to_array().contains(&1.0) {
+        // With a texture Kd only scales texels that are bounded already.
+        if kd.to_array().contains(&1.0) && material.texture.is_none() {
             // Many exporters write white as 1: lowered, or refused when asked to be strict.
             let at_kd = at.kd_line.or(Some(at.line));
             let said = format!("material '{}': Kd {} {} {}", at.name, kd.x, kd.y, kd.z);
@@ -262,7 +338,11 @@ pub(super) fn materials_from(
             };
             return Err(Error::scene(path, line.or(Some(at.line)), problem));
         }
-        if at.kd_line.is_none() && !material.is_emitter() && !material.is_specular() {
+        if at.kd_line.is_none()
+            && at.map_kd.is_none()
+            && !material.is_emitter()
+            && !material.is_specular()
+        {
             warnings.push(format!(
                 "{}:{}: material '{}' has no Kd: it reflects no light",
                 path.display(),
@@ -272,7 +352,7 @@ pub(super) fn materials_from(
         }
         materials.push(material);
     }
-    Ok(materials)
+    Ok((materials, transforms))
 }
 
 /// What the MTL's `illum`, `Ks`, `Ns`, `Pr`, `Pm`, `Ni` and `Tf` make of a material
@@ -373,4 +453,111 @@ fn specular_kind(
         )),
     }
     Ok(())
+}
+
+/// Reads a `map_Kd` statement's words: options, then the file name (which may hold spaces).
+fn map_kd(
+    material: &str,
+    words: Vec<&str>,
+    line: usize,
+    path: &Path,
+    warnings: &mut Vec<String>,
+) -> std::result::Result<MapKd, String> {
+    let mut map = MapKd {
+        file: String::new(),
+        line,
+        scale: Vec2::ONE,
+        offset: Vec2::ZERO,
+    };
+    let mut i = 0;
+    while let Some(&option) = words.get(i).filter(|w| w.starts_with('-')) {
+        let Some(&(_, most)) = MAP_OPTIONS.iter().find(|(o, _)| *o == option) else {
+            return Err(format!(
+                "material '{material}': map_Kd option '{option}' is not one MTL defines"
+            ));
+        };
+        i += 1;
+        // -o, -s and -t take one to three numbers; the others a fixed count.
+        let mut values = Vec::new();
+        while values.len() < most {
+            let Some(word) = words.get(i) else { break };
+            match word.parse::<f32>() {
+                Ok(v) if v.is_finite() => values.push(v),
+                _ if matches!(option, "-o" | "-s") && !values.is_empty() => break,
+                _ if !matches!(option, "-o" | "-s" | "-mm") => values.push(f32::NAN),
+                _ => break,
+            }
+            i += 1;
+        }
+        match option {
+            "-s" | "-o" => {
+                let Some(&u) = values.first() else {
+                    return Err(format!(
+                        "material '{material}': map_Kd {option} needs one to three numbers"
+                    ));
+                };
+                let uv = Vec2::new(u, values.get(1).copied().unwrap_or(u));
+                if option == "-s" {
+                    map.scale = uv;
+                } else {
+                    map.offset = uv;
+                }
+            }
+            _ => warnings.push(format!(
+                "{}:{line}: material '{material}': map_Kd option {option} is ignored",
+                path.display()
+            )),
+        }
+    }
+    map.file = words[i.min(words.len())..].join(" ");
+    if map.file.is_empty() {
+        return Err(format!("material '{material}': map_Kd without a file name"));
+    }
+    Ok(map)
+}
+
+/// The texture a material's `map_Kd` names, read relative to its MTL file; a file missing or
+/// unreadable is a warning (the material keeps Kd, or the default grey without one).
+fn texture_of(
+    files: &dyn super::Source,
+    mtl: &Path,
+    map: &MapKd,
+    material: &mut Material,
+    has_kd: bool,
+    max_reflectance: f32,
+    warnings: &mut Vec<String>,
+) -> Option<UvTransform> {
+    let file = mtl.parent().unwrap_or(Path::new("")).join(&map.file);
+    let read = files
+        .read(&file)
+        .map_err(|e| e.to_string())
+        .and_then(|bytes| Texture::decode(file.display().to_string(), &bytes, max_reflectance));
+    match read {
+        Ok(texture) => {
+            if !has_kd {
+                material.kd = Vec3::ONE;
+            }
+            material.texture = Some(Arc::new(texture));
+            Some(UvTransform {
+                scale: map.scale,
+                offset: map.offset,
+            })
+        }
+        Err(problem) => {
+            let fallback = if has_kd {
+                "the material keeps its Kd".to_string()
+            } else {
+                material.kd = Vec3::splat(super::obj::DEFAULT_KD);
+                format!("the material gets Kd = {} grey", super::obj::DEFAULT_KD)
+            };
+            warnings.push(format!(
+                "{}:{}: material '{}': texture {} cannot be read ({problem}): {fallback}",
+                mtl.display(),
+                map.line,
+                material.name,
+                file.display()
+            ));
+            None
+        }
+    }
 }

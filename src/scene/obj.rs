@@ -12,15 +12,15 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::mtl::{materials_from, read_mtl, MtlLibrary};
+use super::mtl::{materials_from, read_mtl, MtlLibrary, UvTransform};
 use super::validate;
 use super::{Material, Mesh};
 use crate::error::{Error, Result};
 
 /// Reflectance given to faces that name no material (`docs/scene-format.md`).
-const DEFAULT_KD: f32 = 0.5;
+pub(super) const DEFAULT_KD: f32 = 0.5;
 
 const OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
     single_index: false,
@@ -104,8 +104,13 @@ pub(super) fn read(
 
     let mut warnings = missing.into_inner();
     let any_missing = !warnings.is_empty();
-    let mut materials = materials_from(&tobj_materials, &libraries, rules, &mut warnings)?;
+    for library in &libraries {
+        warnings.extend(library.warnings.iter().cloned());
+    }
+    let (mut materials, transforms) =
+        materials_from(files, &tobj_materials, &libraries, rules, &mut warnings)?;
     // A material a missing MTL file may have defined gets the default grey (below).
+    let before = warnings.len();
     if !any_missing {
         check_usemtl(
             path,
@@ -146,8 +151,11 @@ pub(super) fn read(
             mesh.triangle_materials.push(material);
         }
     }
+    // Faces under a usemtl that names nothing, or from a missing MTL, were spoken for above.
+    let said = any_missing || warnings.len() > before;
     mesh.materials = materials;
-    if unassigned > 0 {
+    mesh.texcoords = texcoords(path, &prepared, &mesh, &transforms, &mut warnings);
+    if unassigned > 0 && !said {
         warnings.push(format!(
             "{}: {unassigned} triangle{} have no material: they get Kd = {DEFAULT_KD} grey",
             path.display(),
@@ -163,6 +171,51 @@ pub(super) fn read(
         ));
     }
     Ok((mesh, warnings))
+}
+
+/// Each triangle's image coordinates where its material has a texture and all its corners
+/// have `vt`; empty when no triangle has any.
+fn texcoords(
+    path: &Path,
+    prepared: &PreparedObj,
+    mesh: &Mesh,
+    transforms: &[Option<UvTransform>],
+    warnings: &mut Vec<String>,
+) -> Vec<Option<[Vec2; 3]>> {
+    if prepared.vt.is_empty() || transforms.iter().all(Option::is_none) {
+        return Vec::new();
+    }
+    if prepared.triangle_vt.len() != mesh.triangles.len() {
+        // tobj triangulates faces in file order as fans; a mismatch would pair the wrong
+        // coordinates with a triangle, so none are used rather than wrong ones.
+        warnings.push(format!(
+            "{}: texture coordinates not used: {} triangles read but {} counted",
+            path.display(),
+            mesh.triangles.len(),
+            prepared.triangle_vt.len()
+        ));
+        return Vec::new();
+    }
+    let mut any = false;
+    let out = prepared
+        .triangle_vt
+        .iter()
+        .zip(&mesh.triangle_materials)
+        .map(|(corners, &m)| {
+            let transform = transforms.get(m as usize).copied().flatten()?;
+            let mut uv = [Vec2::ZERO; 3];
+            for (uv, &c) in uv.iter_mut().zip(corners) {
+                *uv = transform.apply(*prepared.vt.get(c as usize)?);
+            }
+            any = true;
+            Some(uv)
+        })
+        .collect();
+    if any {
+        out
+    } else {
+        Vec::new()
+    }
 }
 
 /// Reads a whole file as UTF-8 text; errors name the file and, for bad UTF-8, the line.
@@ -196,7 +249,15 @@ struct PreparedObj {
     mtllib: Vec<(String, usize)>,
     /// Faces with one or two vertices (points, lines), left out.
     short_faces: usize,
+    /// The `vt` coordinates (u, v), in file order.
+    vt: Vec<Vec2>,
+    /// Each triangle's `vt` indices (0-based; `NO_VT` where a corner has none), in the order
+    /// tobj's fan triangulation gives the triangles: faces in file order, (0, i, i + 1).
+    triangle_vt: Vec<[u32; 3]>,
 }
+
+/// A face corner without texture coordinates.
+const NO_VT: u32 = u32::MAX;
 
 fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
     let mut out = String::with_capacity(text.len());
@@ -205,6 +266,9 @@ fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
     let mut short_faces = 0;
     let mut vertices: i64 = 0;
     let mut largest_index: Option<(i64, usize)> = None;
+    let mut vt = Vec::new();
+    let mut triangle_vt = Vec::new();
+    let mut largest_vt: Option<(i64, usize)> = None;
     for (i, raw) in text.split('\n').enumerate() {
         let line = i + 1;
         let fail = |problem: String| Err(Error::scene(path, Some(line), problem));
@@ -226,10 +290,59 @@ fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
                 out.push_str(&coords.join(" "));
                 vertices += 1;
             }
+            Some("vt") => {
+                let coords: Vec<&str> = words.collect();
+                let parsed: Vec<f32> = coords.iter().filter_map(|w| w.parse().ok()).collect();
+                if parsed.len() != coords.len()
+                    || !(1..=3).contains(&parsed.len())
+                    || !parsed.iter().all(|c| c.is_finite())
+                {
+                    return fail(format!(
+                        "texture coordinates need one to three finite numbers u [v [w]], found \
+                         '{}'",
+                        coords.join(" ")
+                    ));
+                }
+                vt.push(Vec2::new(parsed[0], parsed.get(1).copied().unwrap_or(0.0)));
+            }
             Some("f") => {
                 let mut indices = Vec::new();
+                let mut corners_vt = Vec::new();
                 for word in words {
-                    let first = word.split('/').next().unwrap_or("");
+                    let mut parts = word.split('/');
+                    let first = parts.next().unwrap_or("");
+                    let texture = parts.next().filter(|t| !t.is_empty());
+                    corners_vt.push(match texture {
+                        None => NO_VT as i64,
+                        Some(t) => {
+                            let Ok(index) = t.parse::<i64>() else {
+                                return fail(format!(
+                                    "face vertex '{word}': texture index '{t}' is not a number"
+                                ));
+                            };
+                            let count = vt.len() as i64;
+                            match index {
+                                0 => {
+                                    return fail(
+                                        "texture index 0 in a face: OBJ indices start at 1".into(),
+                                    )
+                                }
+                                i if i < 0 && -i > count => {
+                                    return fail(format!(
+                                        "relative texture index {i} points before the first vt \
+                                         ({count} defined so far)"
+                                    ))
+                                }
+                                i if i < 0 => count + i,
+                                i => {
+                                    if largest_vt.is_none_or(|(largest, _)| i > largest) {
+                                        largest_vt = Some((i, line));
+                                    }
+                                    i - 1
+                                }
+                            }
+                        }
+                    });
                     let Ok(index) = first.parse::<i64>() else {
                         return fail(format!(
                             "face vertex '{word}' does not start with a vertex index"
@@ -260,6 +373,10 @@ fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
                 if indices.len() < 3 {
                     short_faces += 1;
                 } else {
+                    let corner = |i: usize| u32::try_from(corners_vt[i]).unwrap_or(NO_VT);
+                    for i in 1..indices.len() - 1 {
+                        triangle_vt.push([corner(0), corner(i), corner(i + 1)]);
+                    }
                     out.push('f');
                     for index in indices {
                         out.push(' ');
@@ -298,11 +415,25 @@ fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
             ));
         }
     }
+    if let Some((index, line)) = largest_vt {
+        if index > vt.len() as i64 {
+            return Err(Error::scene(
+                path,
+                Some(line),
+                format!(
+                    "texture index {index} is out of range: the file defines {} vt",
+                    vt.len()
+                ),
+            ));
+        }
+    }
     Ok(PreparedObj {
         text: out,
         usemtl,
         mtllib,
         short_faces,
+        vt,
+        triangle_vt,
     })
 }
 
@@ -345,7 +476,7 @@ mod tests {
     #[test]
     fn prepare_keeps_line_numbers_and_strips_unused_statements() {
         let text =
-            "# comment\nv 0 0 0\nvt 0 0\nv 1 0 0 1\nv 0 1 0\nvn 0 0 1\nf 1/1/1 2/2/1 -1//1\n";
+            "# comment\nv 0 0 0\nvt 0 0\nv 1 0 0 1\nv 0 1 0\nvn 0 0 1\nf 1/1/1 2/-1/1 -1//1\n";
         let p = prepare_obj(Path::new("t.obj"), text).unwrap();
         let lines: Vec<&str> = p.text.split('\n').collect();
         assert_eq!(lines[0], "");
@@ -354,6 +485,10 @@ mod tests {
         assert_eq!(lines[3], "v 1 0 0");
         assert_eq!(lines[6], "f 1 2 3");
         assert_eq!(line_of(&p.text, p.text.find("f 1").unwrap()), 7);
+        // The texture coordinates: one vt; corners 1 and 2 use it (-1 is the last one), the
+        // third has none.
+        assert_eq!(p.vt, vec![Vec2::ZERO]);
+        assert_eq!(p.triangle_vt, vec![[0, 0, NO_VT]]);
     }
 
     #[test]

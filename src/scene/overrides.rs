@@ -176,15 +176,6 @@ pub(crate) fn apply(
                 };
             }
         }
-        if m.two_sided && m.is_emitter() {
-            return fail(
-                o.two_sided.map_or(o.line, |v| v.1),
-                format!(
-                    "[material.{name}]: two_sided on an emitter: emitters emit from their front \
-                     only for now; flip the faces that face away instead"
-                ),
-            );
-        }
         if let Some((field, problem)) = validate::material_field(m) {
             let line = match field {
                 MaterialField::Kd => o.kd.map(|v| v.1),

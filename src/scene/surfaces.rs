@@ -5,7 +5,7 @@
 
 use std::collections::HashMap;
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 use super::{Material, Mesh, Surface, Triangle};
 
@@ -22,6 +22,8 @@ const DEGENERATE: f64 = 1e-7;
 pub(super) struct Face {
     pub vertices: [Vec3; 3],
     pub material: u32,
+    /// Texture coordinates, when its material has a texture and the mesh gives them.
+    pub texcoords: Option<[Vec2; 3]>,
     normal: DVec3,
     area: f64,
 }
@@ -29,7 +31,12 @@ pub(super) struct Face {
 /// The mesh's triangles with a usable area, and how many were dropped.
 pub(super) fn drop_degenerate(mesh: &Mesh) -> (Vec<Face>, usize) {
     let mut kept = Vec::with_capacity(mesh.triangles.len());
-    for (t, &material) in mesh.triangles.iter().zip(&mesh.triangle_materials) {
+    for (i, (t, &material)) in mesh
+        .triangles
+        .iter()
+        .zip(&mesh.triangle_materials)
+        .enumerate()
+    {
         let vertices = t.map(|i| mesh.positions[i as usize]);
         let [a, b, c] = vertices.map(|v| v.as_dvec3());
         let cross = (b - a).cross(c - a);
@@ -39,9 +46,19 @@ pub(super) fn drop_degenerate(mesh: &Mesh) -> (Vec<Face>, usize) {
             .max((a - c).length_squared());
         let length = cross.length();
         if length > DEGENERATE * longest && length.is_finite() {
+            let textured = mesh
+                .materials
+                .get(material as usize)
+                .is_some_and(|m| m.texture.is_some());
             kept.push(Face {
                 vertices,
                 material,
+                texcoords: mesh
+                    .texcoords
+                    .get(i)
+                    .copied()
+                    .flatten()
+                    .filter(|_| textured),
                 normal: cross / length,
                 area: 0.5 * length,
             });
@@ -51,13 +68,17 @@ pub(super) fn drop_degenerate(mesh: &Mesh) -> (Vec<Face>, usize) {
     (kept, dropped)
 }
 
-/// Groups faces into surfaces; returns the triangles ordered by surface, and the surfaces.
+/// Triangles ordered by surface, the surfaces, and the triangles' texture coordinates (empty
+/// when no triangle has any).
+pub(super) type Grouped = (Vec<Triangle>, Vec<Surface>, Vec<Option<[Vec2; 3]>>);
+
+/// Groups faces into surfaces.
 pub(super) fn group(
     faces: &[Face],
     materials: &[Material],
     two_sided: bool,
     diagonal: f32,
-) -> (Vec<Triangle>, Vec<Surface>) {
+) -> Grouped {
     let neighbours = Adjacency::new(faces);
     let cos_tolerance = ANGLE_TOLERANCE.cos();
     let distance_tolerance = DISTANCE_TOLERANCE * f64::from(diagonal);
@@ -99,6 +120,8 @@ pub(super) fn group(
     }
 
     let mut triangles = Vec::with_capacity(faces.len());
+    let mut texcoords = Vec::new();
+    let textured = faces.iter().any(|f| f.texcoords.is_some());
     let mut surfaces = Vec::with_capacity(members.len());
     for (s, group) in members.iter().enumerate() {
         let start = triangles.len() as u32;
@@ -117,6 +140,9 @@ pub(super) fn group(
                 area: f.area as f32,
                 surface: s as u32,
             });
+            if textured {
+                texcoords.push(f.texcoords);
+            }
         }
         let first = &faces[group[0] as usize];
         surfaces.push(Surface {
@@ -131,7 +157,7 @@ pub(super) fn group(
             },
         });
     }
-    (triangles, surfaces)
+    (triangles, surfaces, texcoords)
 }
 
 /// Which triangles share an edge with which, after welding vertices at equal positions
@@ -249,6 +275,7 @@ mod tests {
             triangles: triangles.to_vec(),
             triangle_materials: vec![0; triangles.len()],
             materials: grey(),
+            texcoords: Vec::new(),
         }
     }
 
@@ -260,7 +287,7 @@ mod tests {
         );
         let (faces, dropped) = drop_degenerate(&flat);
         assert_eq!(dropped, 0);
-        let (tris, surfaces) = group(&faces, &grey(), false, 1.5);
+        let (tris, surfaces, _) = group(&faces, &grey(), false, 1.5);
         assert_eq!((tris.len(), surfaces.len()), (2, 1));
         assert!((surfaces[0].area - 1.0).abs() < 1e-12);
         assert!((surfaces[0].normal - Vec3::Z).length() < 1e-6);
@@ -315,7 +342,7 @@ mod tests {
             &[[0, 2, 1], [0, 1, 3], [0, 1, 4], [0, 1, 4], [0, 1, 5]],
         );
         let (faces, _) = drop_degenerate(&m);
-        let (tris, surfaces) = group(&faces, &grey(), false, 3.0);
+        let (tris, surfaces, _) = group(&faces, &grey(), false, 3.0);
         assert_eq!(surfaces.len(), 3, "{surfaces:?}");
         let floor = surfaces.iter().find(|s| s.normal.z > 0.99).unwrap();
         assert!((floor.area - 1.0).abs() < 1e-9, "{}", floor.area);

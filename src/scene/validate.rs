@@ -37,7 +37,9 @@ pub(crate) fn material_field(m: &Material) -> Option<(MaterialField, String)> {
         );
         return Some((MaterialField::Kd, problem));
     }
-    if m.kd.min_element() < 0.0 || m.kd.max_element() >= 1.0 {
+    // With a texture Kd scales texels that are bounded already: 1 is allowed there.
+    let textured = m.texture.is_some() && m.kd.max_element() <= 1.0;
+    if m.kd.min_element() < 0.0 || (m.kd.max_element() >= 1.0 && !textured) {
         let problem = format!(
             "material '{}': Kd {} is outside [0, 1): a reflectance of 1 or more creates energy",
             m.name,
@@ -216,6 +218,22 @@ pub(crate) fn parts(name: &Path, parts: &SceneParts) -> Result<()> {
             "{} triangles but {} triangle materials",
             mesh.triangles.len(),
             mesh.triangle_materials.len()
+        ));
+    }
+    if !mesh.texcoords.is_empty() && mesh.texcoords.len() != mesh.triangles.len() {
+        return fail(format!(
+            "{} triangles but {} texture coordinate entries (give none, or one per triangle)",
+            mesh.triangles.len(),
+            mesh.texcoords.len()
+        ));
+    }
+    if let Some(i) = mesh
+        .texcoords
+        .iter()
+        .position(|t| t.is_some_and(|uv| !uv.iter().all(|c| c.is_finite())))
+    {
+        return fail(format!(
+            "triangle {i}: its texture coordinates are not finite"
         ));
     }
     for (i, (t, &m)) in mesh

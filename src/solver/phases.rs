@@ -185,6 +185,12 @@ impl Solve<'_> {
             added.changed.as_deref(),
             &mut self.reporter.part(base),
         )?;
+        solution.samples.reflectance = crate::sampling::reflectance::means(
+            self.scene,
+            &solution.samples,
+            &solution.maps,
+            self.options.threads.max(1),
+        )?;
         debug_assert_eq!(solution.validate(), Ok(()));
         Ok(stats)
     }

@@ -16,9 +16,13 @@ use crate::sampling::{is_back, surface_of, Samples};
 use crate::scene::Scene;
 use crate::visibility::Visibility;
 
-/// Diffuse reflectance of sample k's surface.
+/// Diffuse reflectance of sample k: its surface's Kd, or on a textured surface the texture's
+/// mean over its area.
 pub(crate) fn reflectance(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
-    scene.material_of(surface_of(samples.side[k])).kd.as_dvec3()
+    match samples.reflectance.get(k) {
+        Some(rho) => rho.as_dvec3(),
+        None => scene.material_of(surface_of(samples.side[k])).kd.as_dvec3(),
+    }
 }
 
 /// Emitted radiosity π·Ke of sample k (emitters emit from their front only).

@@ -121,7 +121,7 @@ pub(crate) fn mesh(scene: &Scene, size: f32) -> Mesh {
                 hi = hi.max(q);
             }
         }
-        let reflects = material.kd.max_element() > 0.0;
+        let reflects = material.reflects_diffusely();
         let emits = material.is_emitter();
         if triangles.is_empty() || !(reflects || emits) {
             grids.push(Grid {

@@ -193,6 +193,24 @@ fn check(scene: &Scene, options: &PatchOptions) -> Result<()> {
             ),
         ));
     }
+    // Constant patches would show a texture as one colour per patch: refused, not smeared.
+    let textured: Vec<String> = scene
+        .materials
+        .iter()
+        .filter(|m| m.texture.is_some())
+        .map(|m| format!("'{}'", m.name))
+        .collect();
+    if !textured.is_empty() && !scene.texcoords.is_empty() {
+        return Err(Error::argument(
+            "scene",
+            format!(
+                "the patch baseline gives each patch one reflectance, and {} {} textured: render \
+                 it with the meshless solver or the path tracer",
+                textured.join(", "),
+                if textured.len() == 1 { "is" } else { "are" }
+            ),
+        ));
+    }
     let size = options.patch_size;
     if !(size.is_finite() && size > 0.0) {
         return Err(Error::Option {
