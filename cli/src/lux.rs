@@ -10,6 +10,8 @@ use meshlight::lux::{illuminance, LuxOptions};
 use meshlight::scene::luminance;
 use meshlight::{Scene, Solution, Visibility};
 
+use super::plan::{round_label, Plan};
+
 /// One grid's numbers: Emin, Eavg, Emax (luminance-weighted).
 pub struct Summary {
     /// The smallest.
@@ -105,7 +107,7 @@ pub fn run(
         out.flush()?;
         let s = Summary::of(&open);
         let line = format!(
-            "grid '{}': {} points{}, Emin {:.4} {unit}, Eavg {:.4} {unit}, Emax {:.4} {unit}, U0 = Emin/Eavg {:.3}, Emin/Emax {:.3}; {:.2} s",
+            "grid '{}': {} points{}, Emin {} {unit}, Eavg {} {unit}, Emax {} {unit}, U0 = Emin/Eavg {:.2}, Emin/Emax {:.2}; {:.2} s",
             grid.name(),
             values.len(),
             if left_out > 0 {
@@ -113,27 +115,37 @@ pub fn run(
             } else {
                 String::new()
             },
-            s.min,
-            s.avg,
-            s.max,
+            round_label(s.min),
+            round_label(s.avg),
+            round_label(s.max),
             s.uniformity(),
             s.diversity(),
             started.elapsed().as_secs_f64()
         );
         let png = dir.join(format!("{stem}.png"));
-        super::plot::plan_png(
+        let (nu, nv) = grid.counts_uv();
+        let (u, v) = grid.edges();
+        let caption = [
+            format!("Emin {} {unit}", round_label(s.min)),
+            format!("Eavg {} {unit}", round_label(s.avg)),
+            format!("Emax {} {unit}", round_label(s.max)),
+            format!("U0 {:.2}", s.uniformity()),
+        ];
+        super::plan::plan_png(
             &png,
-            grid.counts_uv(),
-            &values,
-            (0.0, s.max),
-            unit,
-            &format!("{} ({unit})", grid.name()),
-            &[
-                format!("Emin {:.4}", s.min),
-                format!("Eavg {:.4}", s.avg),
-                format!("Emax {:.4}", s.max),
-                format!("U0 {:.3}", s.uniformity()),
-            ],
+            &Plan {
+                counts: (nu, nv),
+                values: &values,
+                excluded: &inside,
+                spacing: (
+                    f64::from(u.length()) / f64::from(nu),
+                    f64::from(v.length()) / f64::from(nv),
+                ),
+                marks: &lights_over(scene, grid),
+                unit,
+                title: &format!("{} ({unit})", grid.name()),
+                caption: &caption,
+            },
         )?;
         println!("{line}");
         if let Some(verdict) = targets(grid.target_em(), grid.target_u0(), &s, unit) {
@@ -142,6 +154,24 @@ pub fn run(
         println!("wrote {} and {}", csv.display(), png.display());
     }
     Ok(())
+}
+
+/// The point lights and luminaires over a grid, in its coordinates (point (i, j) at (i, j)):
+/// their feet on its plane, those that fall on the plan.
+fn lights_over(scene: &Scene, grid: &meshlight::scene::Grid) -> Vec<(f64, f64)> {
+    let (nu, nv) = grid.counts_uv();
+    let (u, v) = grid.edges();
+    scene
+        .point_sources()
+        .iter()
+        .filter_map(|light| {
+            let d = light.position - grid.origin();
+            let x = f64::from(d.dot(u) / u.length_squared()) * f64::from(nu) - 0.5;
+            let y = f64::from(d.dot(v) / v.length_squared()) * f64::from(nv) - 0.5;
+            let on = |c: f64, n: u32| c >= -0.5 && c <= f64::from(n) - 0.5;
+            (on(x, nu) && on(y, nv)).then_some((x, y))
+        })
+        .collect()
 }
 
 /// Whether a grid meets its targets, and by how much: "meets Ēm 500 lx (+12.3%) and U0 0.6

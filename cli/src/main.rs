@@ -5,6 +5,7 @@ mod bench;
 mod errors;
 mod lux;
 mod memory;
+mod plan;
 mod plot;
 mod progress;
 mod reference;

@@ -50,7 +50,7 @@ fn font() -> Result<()> {
         .map_err(|e| anyhow!(e))
 }
 
-fn plot_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+pub(crate) fn plot_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow!("drawing failed: {e:?}")
 }
 
@@ -110,21 +110,21 @@ pub fn percent_label(fraction: f64) -> String {
 }
 
 /// The drawing area of a picture.
-type Root<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+pub(crate) type Root<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// What a false-colour picture's legend says.
-struct Legend<'a> {
-    title: String,
+pub(crate) struct Legend<'a> {
+    pub title: String,
     /// The colour at a height on the bar: 1 at the top, 0 at the bottom.
-    colour: &'a dyn Fn(f32) -> [u8; 3],
+    pub colour: &'a dyn Fn(f32) -> [u8; 3],
     /// The values at 1, ¾, ½, ¼ and 0 of the bar, top down.
-    labels: [String; 5],
+    pub labels: [String; 5],
     /// Lines under the bar.
-    caption: &'a [String],
+    pub caption: &'a [String],
 }
 
 /// Writes a picture of `width` × `height` that `paint` draws, with `legend` to its right.
-fn with_legend(
+pub(crate) fn with_legend(
     path: &Path,
     (width, height): (u32, u32),
     paint: impl FnOnce(&Root) -> Result<()>,
@@ -275,65 +275,6 @@ pub fn sequential_png(
         caption: &[],
     };
     with_legend(path, (width, height), paint, &legend)
-}
-
-/// Writes a false-colour plan of a grid's values (`nu` × `nv`, row by row along u) from
-/// `low` to `high`, cells scaled to about 480 pixels along the longer side, with iso-lines at
-/// the legend's three inner values, a colour bar labelled in `unit`, a title and caption lines.
-pub fn plan_png(
-    path: &Path,
-    (nu, nv): (u32, u32),
-    values: &[f64],
-    (low, high): (f64, f64),
-    unit: &str,
-    title: &str,
-    caption: &[String],
-) -> Result<()> {
-    let cell = (480 / nu.max(nv)).clamp(1, 64);
-    let span = if high > low { high - low } else { 1.0 };
-    let paint = |root: &Root| -> Result<()> {
-        let c = cell as i32;
-        // Row j along v drawn from the bottom up, so the plan reads with v upwards.
-        let corner = |i: u32, j: u32| ((i * cell) as i32, ((nv - 1 - j) * cell) as i32);
-        for j in 0..nv {
-            for i in 0..nu {
-                let t = (values[(j * nu + i) as usize] - low) / span;
-                let [r, g, b] = sequential(t as f32);
-                let (x, y) = corner(i, j);
-                root.draw(&Rectangle::new(
-                    [(x, y), (x + c, y + c)],
-                    RGBColor(r, g, b).filled(),
-                ))
-                .map_err(plot_error)?;
-            }
-        }
-        // Iso-lines: cell edges where the value crosses one of the legend's inner levels.
-        for k in 1..4 {
-            let iso = low + span * f64::from(k) / 4.0;
-            let above = |i: u32, j: u32| values[(j * nu + i) as usize] >= iso;
-            for j in 0..nv {
-                for i in 0..nu {
-                    let (x, y) = corner(i, j);
-                    if i + 1 < nu && above(i, j) != above(i + 1, j) {
-                        root.draw(&PathElement::new(vec![(x + c, y), (x + c, y + c)], BLACK))
-                            .map_err(plot_error)?;
-                    }
-                    if j + 1 < nv && above(i, j) != above(i, j + 1) {
-                        root.draw(&PathElement::new(vec![(x, y), (x + c, y)], BLACK))
-                            .map_err(plot_error)?;
-                    }
-                }
-            }
-        }
-        Ok(())
-    };
-    let legend = Legend {
-        title: title.to_string(),
-        colour: &sequential,
-        labels: value_labels(low, low + span, false, unit),
-        caption,
-    };
-    with_legend(path, (nu * cell, nv * cell), paint, &legend)
 }
 
 /// Writes `image`'s signed error against `reference` as a false-colour picture; answers the

@@ -440,8 +440,9 @@ fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
         assert!((v / want - 1.0).abs() < 0.02, "{v} vs {want}");
     }
     let avg = e.iter().sum::<f64>() / 6.0;
+    // Three significant figures, as designers read them (0.6 to 1: three decimals).
     assert!(
-        line.contains(&format!("Eavg {avg:.4} W/m²")),
+        line.contains(&format!("Eavg {avg:.3} W/m²")),
         "{line} (avg {avg:.4})"
     );
     assert!(
@@ -587,4 +588,84 @@ fn a_gltf_renders_on_its_own_from_the_camera_named() {
     assert!(!run.status.success());
     let stderr = text(&run.stderr);
     assert!(stderr.contains("no camera 'Kamera'"), "{stderr}");
+}
+
+#[test]
+fn lux_plans_trace_iso_lines_on_a_point_lights_circles_and_hatch_solids() {
+    // A 10 m square floor (nearly black, so the light is the point light's alone), a 1 m box
+    // standing on it at x, z ∈ [1, 2], a point light of 1000 W/sr 2 m over the floor's centre,
+    // and a grid 0.05 m over the floor, 0.25 m apart. E = I h / (r² + h²)^{3/2} with h = 1.95:
+    // the 50, 100 and 150 W/m² iso-lines are circles of radius r = √((I h / E)^{2/3} − h²),
+    // by hand. The plan is to scale, 48 pixels a metre (480 for the 10 m), its left edge at
+    // pixel 52 and its top at 10 (docs/cli.md): on each circle, at 36 angles, a black line pixel
+    // lies within half a spacing (6 px) of the radius at most of them (labels cover a few).
+    // Points inside the box are hatched grey, never the colour of 0 lx.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("floor.obj"),
+        "mtllib floor.mtl\nusemtl dark\nv 0 0 0\nv 0 0 10\nv 10 0 10\nv 10 0 0\nf 1 2 3 4\n\
+         v 1 0 1\nv 2 0 1\nv 2 0 2\nv 1 0 2\nv 1 1 1\nv 2 1 1\nv 2 1 2\nv 1 1 2\n\
+         f 5 6 7 8\nf 9 12 11 10\nf 5 9 10 6\nf 6 10 11 7\nf 7 11 12 8\nf 8 12 9 5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("floor.mtl"),
+        "newmtl dark\nKd 0.01 0.01 0.01\n",
+    )
+    .unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(
+        &scene,
+        "obj = \"floor.obj\"\n[camera]\nposition = [5, 8, 5]\nlook_at = [5, 0, 5.01]\nfov_y = 60\n\
+         width = 16\nheight = 16\n[[point_light]]\nposition = [5, 2, 5]\nintensity = [1000, 1000, 1000]\n\
+         [[grid]]\nname = \"floor\"\norigin = [0, 0.05, 0]\nu = [10, 0, 0]\nv = [0, 0, 10]\n\
+         normal = [0, 1, 0]\nspacing = 0.25\n",
+    )
+    .unwrap();
+    let out_dir = dir.path().join("lux");
+    let out = meshlight(&[
+        "lux",
+        scene.to_str().unwrap(),
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let png = image::open(out_dir.join("floor.png")).unwrap().to_rgb8();
+    // Floor metres (x along u, z along v) to pixels: v runs up the picture.
+    let pixel = |x: f64, z: f64| (52.0 + 48.0 * x, 10.0 + 480.0 - 48.0 * z);
+    let black = |x: f64, y: f64| {
+        let (x, y) = (x.round() as u32, y.round() as u32);
+        png.get_pixel(x, y).0 == [0, 0, 0]
+    };
+    let (i, h) = (1000.0f64, 1.95f64);
+    for level in [50.0, 100.0, 150.0] {
+        let r = ((i * h / level).powf(2.0 / 3.0) - h * h).sqrt();
+        let found = (0..36)
+            .filter(|k| {
+                let a = f64::from(*k) * std::f64::consts::TAU / 36.0;
+                (-6..=6).any(|d| {
+                    let rr = r + f64::from(d) / 48.0;
+                    let (px, py) = pixel(5.0 + rr * a.cos(), 5.0 + rr * a.sin());
+                    black(px, py)
+                })
+            })
+            .count();
+        assert!(
+            found >= 30,
+            "{level} W/m² (r {r:.3} m): a line at {found} of 36 angles"
+        );
+    }
+    // The box's footprint: hatched (light or dark grey), not sequential(0) dark blue.
+    for (x, z) in [(1.5, 1.5), (1.3, 1.7), (1.6, 1.2)] {
+        let (px, py) = pixel(x, z);
+        let c = png.get_pixel(px.round() as u32, py.round() as u32).0;
+        assert!(
+            c == [215, 215, 215] || c == [150, 150, 150],
+            "{x}, {z}: {c:?}"
+        );
+    }
+    // And a measured point beside it is coloured.
+    let (px, py) = pixel(3.0, 3.0);
+    let c = png.get_pixel(px as u32, py as u32).0;
+    assert!(c[0] != c[1] || c[1] != c[2], "{c:?}");
 }
