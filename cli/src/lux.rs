@@ -175,7 +175,7 @@ fn lights_over(scene: &Scene, grid: &meshlight::scene::Grid) -> Vec<(f64, f64)> 
 }
 
 /// Whether a grid meets its targets, and by how much: "meets Ēm 500 lx (+12.3%) and U0 0.6
-/// (0.71)" or "does NOT meet Ēm 500 lx: 46.100 lx short (-9.2%)". None without targets.
+/// (0.71)" or "does NOT meet Ēm 500 lx: 46.1 lx short (-9.2%)". None without targets.
 fn targets(em: Option<f64>, u0: Option<f64>, s: &Summary, unit: &str) -> Option<String> {
     let mut met = Vec::new();
     let mut failed = Vec::new();
@@ -185,8 +185,8 @@ fn targets(em: Option<f64>, u0: Option<f64>, s: &Summary, unit: &str) -> Option<
             met.push(format!("Ēm {em} {unit} ({margin:+.1}%)"));
         } else {
             failed.push(format!(
-                "Ēm {em} {unit}: {:.3} {unit} short ({margin:+.1}%)",
-                em - s.avg
+                "Ēm {em} {unit}: {} {unit} short ({margin:+.1}%)",
+                round_label(em - s.avg)
             ));
         }
     }
@@ -225,7 +225,7 @@ mod tests {
         // 550 lx asked: 50 short, −9.1%; U0 0.7 asked: only 0.60.
         assert_eq!(
             targets(Some(550.0), Some(0.7), &s, "lx").unwrap(),
-            "does NOT meet Ēm 550 lx: 50.000 lx short (-9.1%); nor U0 0.7: only 0.60"
+            "does NOT meet Ēm 550 lx: 50 lx short (-9.1%); nor U0 0.7: only 0.60"
         );
         assert_eq!(
             targets(Some(400.0), Some(0.7), &s, "lx").unwrap(),
