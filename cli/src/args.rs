@@ -309,6 +309,25 @@ pub enum Command {
               value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::solver::MAX_SPECULAR_RAYS)))]
         grid_specular_rays: u32,
     },
+    /// Solve a scene and write a lighting report: one self-contained HTML page (DIR/index.html)
+    /// with the luminaire schedule, every grid's figures and targets, the isolux plans, the
+    /// rendered view and how it was computed; the grids' CSVs and plans beside it
+    Report {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// Folder for index.html, the grids' CSV and PNG files and view.png.
+        #[arg(short, long, default_value = "report")]
+        output: PathBuf,
+        /// Shadow rays per area light and grid point.
+        #[arg(long, default_value_t = 64,
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
+        grid_light_samples: u32,
+        /// Chains followed from each grid point through mirrors, glossy surfaces and glass
+        /// (scenes with specular materials only).
+        #[arg(long, default_value_t = meshlight::lux::LuxOptions::default().specular_rays,
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::solver::MAX_SPECULAR_RAYS)))]
+        grid_specular_rays: u32,
+    },
     /// Solve a scene and write the samples (position, normal, colour, radius) as PLY.
     Samples {
         #[command(flatten)]

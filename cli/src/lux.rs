@@ -39,7 +39,7 @@ impl Summary {
     }
 
     /// Emin / Eavg.
-    fn uniformity(&self) -> f64 {
+    pub fn uniformity(&self) -> f64 {
         if self.avg > 0.0 {
             self.min / self.avg
         } else {
@@ -48,13 +48,31 @@ impl Summary {
     }
 
     /// Emin / Emax.
-    fn diversity(&self) -> f64 {
+    pub fn diversity(&self) -> f64 {
         if self.max > 0.0 {
             self.min / self.max
         } else {
             0.0
         }
     }
+}
+
+/// One grid measured: what `lux` prints and `report` tabulates.
+pub struct Measured {
+    /// The grid's name.
+    pub name: String,
+    /// Its points, and how many of them lie inside solids (left out).
+    pub points: usize,
+    pub left_out: usize,
+    /// Emin, Eavg, Emax over the points left in.
+    pub summary: Summary,
+    /// Its targets, and whether they are met ("meets …" / "does NOT meet …").
+    pub target_em: Option<f64>,
+    pub target_u0: Option<f64>,
+    pub verdict: Option<String>,
+    /// The CSV and the plan written.
+    pub csv: std::path::PathBuf,
+    pub png: std::path::PathBuf,
 }
 
 /// Measures every grid, writing `DIR/<name>.csv` and `DIR/<name>.png` and printing a line per
@@ -66,6 +84,17 @@ pub fn run(
     options: &LuxOptions,
     dir: &Path,
 ) -> Result<()> {
+    measure(scene, solution, vis, options, dir).map(|_| ())
+}
+
+/// As [`run`], answering what it measured.
+pub fn measure(
+    scene: &Scene,
+    solution: &Solution,
+    vis: &dyn Visibility,
+    options: &LuxOptions,
+    dir: &Path,
+) -> Result<Vec<Measured>> {
     if scene.grids().is_empty() {
         anyhow::bail!(
             "{}: the scene has no [[grid]] to measure (docs/scene-format.md, \"Grids\")",
@@ -74,6 +103,7 @@ pub fn run(
     }
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     let unit = scene.units().irradiance();
+    let mut measured = Vec::new();
     for grid in scene.grids() {
         let started = Instant::now();
         let points = grid.points();
@@ -148,12 +178,24 @@ pub fn run(
             },
         )?;
         println!("{line}");
-        if let Some(verdict) = targets(grid.target_em(), grid.target_u0(), &s, unit) {
+        let verdict = targets(grid.target_em(), grid.target_u0(), &s, unit);
+        if let Some(verdict) = &verdict {
             println!("grid '{}': {verdict}", grid.name());
         }
         println!("wrote {} and {}", csv.display(), png.display());
+        measured.push(Measured {
+            name: grid.name().to_string(),
+            points: values.len(),
+            left_out,
+            summary: s,
+            target_em: grid.target_em(),
+            target_u0: grid.target_u0(),
+            verdict,
+            csv,
+            png,
+        });
     }
-    Ok(())
+    Ok(measured)
 }
 
 /// The point lights and luminaires over a grid, in its coordinates (point (i, j) at (i, j)):

@@ -5,6 +5,7 @@ mod bench;
 mod errors;
 mod lux;
 mod memory;
+mod page;
 mod plan;
 mod plot;
 mod progress;
@@ -81,6 +82,17 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
             };
             lux::run(&scene, &solution, vis.as_ref(), &lux, &output)
         }
+        Command::Report {
+            solve,
+            output,
+            grid_light_samples,
+            grid_specular_rays,
+        } => report_command(
+            &solve,
+            &output,
+            (grid_light_samples, grid_specular_rays),
+            loading,
+        ),
         Command::Samples { solve, output } => samples(&solve, &output, loading),
         Command::Scale {
             scene,
@@ -99,6 +111,52 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
         }
         Command::BenchVis(bench) => bench_vis(bench, loading),
     }
+}
+
+/// `report`: solve, measure the grids, render the view, and write the page.
+fn report_command(
+    solve: &SolveArgs,
+    output: &Path,
+    (light_samples, specular_rays): (u32, u32),
+    loading: &LoadOptions,
+) -> anyhow::Result<()> {
+    let (scene, options) = solve_setup(solve, loading)?;
+    let vis = backend_from(&solve.knobs).build(&scene)?;
+    diagnose(&scene, vis.as_ref())?;
+    let t = std::time::Instant::now();
+    let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+    let summary = solve_summary(&scene, &solution, &options, vis.name());
+    print!("{summary}");
+    let solving = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let lux_options = meshlight::lux::LuxOptions {
+        light_samples: light_samples.max(1),
+        specular_rays,
+        seed: options.seed,
+        threads: options.threads,
+    };
+    let grids = lux::measure(&scene, &solution, vis.as_ref(), &lux_options, output)?;
+    let measuring = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let render_options = meshlight::RenderOptions {
+        threads: options.threads,
+        ..meshlight::RenderOptions::default()
+    };
+    let (image, _) = progress::with_progress("render", |progress| {
+        meshlight::render(&scene, &solution, vis.as_ref(), &render_options, progress)
+    })?;
+    let view_path = output.join("view.png");
+    image.write_png(&view_path, image.auto_exposure())?;
+    let view = std::fs::read(&view_path)?;
+    let rendering = t.elapsed().as_secs_f64();
+    let extras = page::Extras {
+        view: Some(view),
+        summary: &summary,
+        seconds: (solving, measuring, rendering),
+    };
+    let path = page::write(output, &scene, &solution, &grids, &extras)?;
+    println!("wrote {}", path.display());
+    Ok(())
 }
 
 /// `render`: solve (or trace, or patch) and write the image, its PNG and a summary.

@@ -600,28 +600,7 @@ fn lux_plans_trace_iso_lines_on_a_point_lights_circles_and_hatch_solids() {
     // pixel 52 and its top at 10 (docs/cli.md): on each circle, at 36 angles, a black line pixel
     // lies within half a spacing (6 px) of the radius at most of them (labels cover a few).
     // Points inside the box are hatched grey, never the colour of 0 lx.
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("floor.obj"),
-        "mtllib floor.mtl\nusemtl dark\nv 0 0 0\nv 0 0 10\nv 10 0 10\nv 10 0 0\nf 1 2 3 4\n\
-         v 1 0 1\nv 2 0 1\nv 2 0 2\nv 1 0 2\nv 1 1 1\nv 2 1 1\nv 2 1 2\nv 1 1 2\n\
-         f 5 6 7 8\nf 9 12 11 10\nf 5 9 10 6\nf 6 10 11 7\nf 7 11 12 8\nf 8 12 9 5\n",
-    )
-    .unwrap();
-    std::fs::write(
-        dir.path().join("floor.mtl"),
-        "newmtl dark\nKd 0.01 0.01 0.01\n",
-    )
-    .unwrap();
-    let scene = dir.path().join("scene.toml");
-    std::fs::write(
-        &scene,
-        "obj = \"floor.obj\"\n[camera]\nposition = [5, 8, 5]\nlook_at = [5, 0, 5.01]\nfov_y = 60\n\
-         width = 16\nheight = 16\n[[point_light]]\nposition = [5, 2, 5]\nintensity = [1000, 1000, 1000]\n\
-         [[grid]]\nname = \"floor\"\norigin = [0, 0.05, 0]\nu = [10, 0, 0]\nv = [0, 0, 10]\n\
-         normal = [0, 1, 0]\nspacing = 0.25\n",
-    )
-    .unwrap();
+    let (dir, scene) = floor_scene("");
     let out_dir = dir.path().join("lux");
     let out = meshlight(&[
         "lux",
@@ -668,4 +647,112 @@ fn lux_plans_trace_iso_lines_on_a_point_lights_circles_and_hatch_solids() {
     let (px, py) = pixel(3.0, 3.0);
     let c = png.get_pixel(px as u32, py as u32).0;
     assert!(c[0] != c[1] || c[1] != c[2], "{c:?}");
+}
+
+/// A 10 m square floor (nearly black), a 1 m box on it at x, z ∈ [1, 2], a point light of
+/// 1000 W/sr 2 m over the floor's centre, and a grid "floor" 0.05 m over it, 0.25 m apart;
+/// `extra` is added to the scene file.
+fn floor_scene(extra: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("floor.obj"),
+        "mtllib floor.mtl\nusemtl dark\nv 0 0 0\nv 0 0 10\nv 10 0 10\nv 10 0 0\nf 1 2 3 4\n\
+         v 1 0 1\nv 2 0 1\nv 2 0 2\nv 1 0 2\nv 1 1 1\nv 2 1 1\nv 2 1 2\nv 1 1 2\n\
+         f 5 6 7 8\nf 9 12 11 10\nf 5 9 10 6\nf 6 10 11 7\nf 7 11 12 8\nf 8 12 9 5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("floor.mtl"),
+        "newmtl dark\nKd 0.01 0.01 0.01\n",
+    )
+    .unwrap();
+    let scene = dir.path().join("scene.toml");
+    let toml = "obj = \"floor.obj\"\n[camera]\nposition = [5, 8, 5]\nlook_at = [5, 0, 5.01]\n\
+                fov_y = 60\nwidth = 16\nheight = 16\n[[point_light]]\nposition = [5, 2, 5]\n\
+                intensity = [1000, 1000, 1000]\n[[grid]]\nname = \"floor\"\n\
+                origin = [0, 0.05, 0]\nu = [10, 0, 0]\nv = [0, 0, 10]\nnormal = [0, 1, 0]\n\
+                spacing = 0.25\n"
+        .to_string()
+        + extra;
+    std::fs::write(&scene, toml).unwrap();
+    (dir, scene)
+}
+
+#[test]
+fn report_writes_one_self_contained_page_with_every_grid_and_its_targets() {
+    // The floor scene with a second grid that asks for more than it gets: the page lists both
+    // grids with Ēm as their CSVs give it (within 0.1%; the floor's points inside the box left
+    // out), marks the second as failing with its shortfall, embeds every picture as a PNG that
+    // decodes, and needs no script or network.
+    let (dir, scene) = floor_scene(
+        "[[grid]]\nname = \"near the box\"\norigin = [0.5, 0.05, 3]\nu = [2, 0, 0]\n\
+         v = [0, 0, 1]\nnormal = [0, 1, 0]\nspacing = 0.25\ntarget_em = 1000\ntarget_u0 = 0.5\n",
+    );
+    let out_dir = dir.path().join("report");
+    let out = meshlight(&[
+        "report",
+        scene.to_str().unwrap(),
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let html = std::fs::read_to_string(out_dir.join("index.html")).unwrap();
+    assert!(!html.contains("<script") && !html.contains("http://") && !html.contains("https://"));
+    for (grid, csv) in [("floor", "floor.csv"), ("near the box", "near_the_box.csv")] {
+        let csv = std::fs::read_to_string(out_dir.join(csv)).unwrap();
+        let row = html
+            .split("<tr data-em=\"")
+            .skip(1)
+            .find(|r| r.contains(&format!("<td>{grid}</td>")))
+            .unwrap_or_else(|| panic!("no row for {grid}"));
+        let em: f64 = row.split('"').next().unwrap().parse().unwrap();
+        let outside: Vec<f64> = csv
+            .lines()
+            .skip(1)
+            .filter_map(|r| {
+                let f: Vec<f64> = r.split(',').map(|v| v.parse().unwrap()).collect();
+                let inside = (1.0..=2.0).contains(&f[0]) && (1.0..=2.0).contains(&f[2]);
+                (!inside).then_some(f[3])
+            })
+            .collect();
+        let mean = outside.iter().sum::<f64>() / outside.len() as f64;
+        assert!(
+            (em / mean - 1.0).abs() < 1e-3,
+            "{grid}: page {em}, CSV {mean}"
+        );
+        if grid == "near the box" {
+            assert!(
+                row.contains("class=\"fail\"") && row.contains("short"),
+                "{row}"
+            );
+        }
+    }
+    let images: Vec<&str> = html.split("src=\"data:image/png;base64,").skip(1).collect();
+    assert_eq!(images.len(), 3, "two plans and the view");
+    for b64 in images {
+        let bytes = decode_base64(b64.split('"').next().unwrap());
+        assert!(image::load_from_memory(&bytes).is_ok());
+    }
+}
+
+/// Base64 (RFC 4648) decoded, written out here rather than taken from the program.
+fn decode_base64(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        _ => 63,
+    };
+    let mut out = Vec::new();
+    let (mut bits, mut count) = (0u32, 0);
+    for c in text.bytes().take_while(|&c| c != b'=') {
+        bits = (bits << 6) | u32::from(value(c));
+        count += 6;
+        if count >= 8 {
+            count -= 8;
+            out.push((bits >> count) as u8);
+        }
+    }
+    out
 }
