@@ -172,6 +172,7 @@ pub fn measure(
                     f64::from(v.length()) / f64::from(nv),
                 ),
                 marks: &lights_over(scene, grid),
+                outline: &cut(scene, grid),
                 unit,
                 title: &format!("{} ({unit})", grid.name()),
                 caption: &caption,
@@ -214,6 +215,37 @@ fn lights_over(scene: &Scene, grid: &meshlight::scene::Grid) -> Vec<(f64, f64)> 
             (on(x, nu) && on(y, nv)).then_some((x, y))
         })
         .collect()
+}
+
+/// The scene's triangles cut by a grid's plane, as segments in its coordinates (point (i, j)
+/// at (i, j)): what a plan draws of walls and furniture.
+fn cut(scene: &Scene, grid: &meshlight::scene::Grid) -> Vec<[(f64, f64); 2]> {
+    let (nu, nv) = grid.counts_uv();
+    let (u, v) = grid.edges();
+    let n = u.cross(v).normalize_or_zero();
+    let origin = grid.origin();
+    let to_grid = |p: glam::Vec3| {
+        let d = p - origin;
+        (
+            f64::from(d.dot(u) / u.length_squared()) * f64::from(nu) - 0.5,
+            f64::from(d.dot(v) / v.length_squared()) * f64::from(nv) - 0.5,
+        )
+    };
+    let mut out = Vec::new();
+    for t in scene.triangles() {
+        let h = t.vertices.map(|p| n.dot(p - origin));
+        let mut ends = Vec::with_capacity(2);
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            if (h[a] < 0.0) != (h[b] < 0.0) {
+                let s = h[a] / (h[a] - h[b]);
+                ends.push(to_grid(t.vertices[a] + s * (t.vertices[b] - t.vertices[a])));
+            }
+        }
+        if let [a, b] = ends[..] {
+            out.push([a, b]);
+        }
+    }
+    out
 }
 
 /// Whether a grid meets its targets, and by how much: "meets Ēm 500 lx (+12.3%) and U0 0.6

@@ -22,6 +22,8 @@ pub struct Plan<'a> {
     pub spacing: (f64, f64),
     /// Luminaires over the grid, in grid units (point (i, j) at (i, j)).
     pub marks: &'a [(f64, f64)],
+    /// The scene cut by the grid's plane (walls, furniture), as segments in grid units.
+    pub outline: &'a [[(f64, f64); 2]],
     /// The values' unit.
     pub unit: &'a str,
     /// Over the legend.
@@ -292,6 +294,23 @@ pub fn plan_png(path: &Path, plan: &Plan) -> Result<()> {
                     .map_err(plot_error)?;
             }
         }
+        // The scene's cut, clipped to the plan: drawn over the field, under the marks.
+        let (lo, hi) = (
+            (-0.5, -0.5),
+            (
+                f64::from(plan.counts.0) - 0.5,
+                f64::from(plan.counts.1) - 0.5,
+            ),
+        );
+        for segment in plan.outline {
+            if let Some([a, b]) = clip(*segment, lo, hi) {
+                root.draw(&PathElement::new(
+                    vec![pixel(a), pixel(b)],
+                    RGBColor(70, 70, 70).stroke_width(2),
+                ))
+                .map_err(plot_error)?;
+            }
+        }
         for &m in plan.marks {
             let (x, y) = pixel(m);
             root.draw(&Circle::new((x, y), 5, WHITE.filled()))
@@ -330,6 +349,36 @@ pub fn plan_png(path: &Path, plan: &Plan) -> Result<()> {
         caption: plan.caption,
     };
     with_legend(path, (LEFT + pw + RIGHT, TOP + ph + BOTTOM), paint, &legend)
+}
+
+/// The part of segment `s` inside the box `lo`–`hi` (Liang–Barsky), if any.
+fn clip(s: [(f64, f64); 2], lo: (f64, f64), hi: (f64, f64)) -> Option<[(f64, f64); 2]> {
+    let [a, b] = s;
+    let d = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-d.0, a.0 - lo.0),
+        (d.0, hi.0 - a.0),
+        (-d.1, a.1 - lo.1),
+        (d.1, hi.1 - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let t = q / p;
+            if p < 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+    }
+    (t0 <= t1).then(|| {
+        let at = |t: f64| (a.0 + t * d.0, a.1 + t * d.1);
+        [at(t0), at(t1)]
+    })
 }
 
 /// A scale bar of a round length in metres, about 80 pixels long, at `(x, y)`.
@@ -411,6 +460,20 @@ mod tests {
         assert!(levels(5.0, 5.0).is_empty());
         assert_eq!(nice_step(0.07), 0.05);
         assert_eq!(nice_step(300.0), 200.0);
+    }
+
+    #[test]
+    fn segments_are_clipped_to_the_plan() {
+        let (lo, hi) = ((0.0, 0.0), (1.0, 1.0));
+        assert_eq!(
+            clip([(-1.0, 0.5), (2.0, 0.5)], lo, hi),
+            Some([(0.0, 0.5), (1.0, 0.5)])
+        );
+        assert_eq!(clip([(2.0, 2.0), (3.0, 3.0)], lo, hi), None);
+        assert_eq!(
+            clip([(0.2, 0.2), (0.4, 0.6)], lo, hi),
+            Some([(0.2, 0.2), (0.4, 0.6)])
+        );
     }
 
     #[test]
