@@ -756,3 +756,112 @@ fn decode_base64(text: &str) -> Vec<u8> {
     }
     out
 }
+
+/// Chromium, if installed (CI installs Debian's `chromium`); without it a test that needs it
+/// is skipped, unless `MESHLIGHT_REQUIRE_CHROMIUM` is set (as CI sets it): then it fails.
+fn chromium() -> Option<&'static str> {
+    let found = ["chromium", "chromium-browser"].into_iter().find(|c| {
+        Command::new(c)
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var_os("MESHLIGHT_REQUIRE_CHROMIUM").is_none(),
+            "MESHLIGHT_REQUIRE_CHROMIUM is set but no chromium is installed"
+        );
+        eprintln!("skipped: no chromium installed (apt-get install chromium)");
+    }
+    found
+}
+
+/// Runs headless Chromium on a page with `args`, within 60 s; its output.
+fn headless(chromium: &str, page: &std::path::Path, args: &[&str]) -> Output {
+    let output = Command::new("timeout")
+        .args([
+            "60",
+            chromium,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+        ])
+        .args(args)
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .expect("run chromium");
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    output
+}
+
+#[test]
+fn the_report_opens_in_headless_chromium_and_prints_a_page_per_section() {
+    // A real browser: the DOM it builds holds the grid table with every grid; a screenshot
+    // shows the plans (the box's hatch, grey 150, is drawn: the images decoded); nothing goes
+    // to the console; printed to PDF, each of the five sections starts a page.
+    let Some(chromium) = chromium() else { return };
+    let (dir, scene) = floor_scene(
+        "[[grid]]\nname = \"near the box\"\norigin = [0.5, 0.05, 3]\nu = [2, 0, 0]\n\
+         v = [0, 0, 1]\nnormal = [0, 1, 0]\nspacing = 0.25\ntarget_em = 1000\n",
+    );
+    let out_dir = dir.path().join("report");
+    let out = meshlight(&[
+        "report",
+        scene.to_str().unwrap(),
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let page = out_dir.join("index.html");
+    let dom = text(&headless(chromium, &page, &["--dump-dom"]).stdout);
+    let table = dom
+        .split("<table id=\"grid-table\">")
+        .nth(1)
+        .and_then(|t| t.split("</table>").next())
+        .unwrap_or_else(|| panic!("no grid table in the DOM:\n{dom}"));
+    for grid in ["floor", "near the box"] {
+        assert!(
+            table.contains(&format!("<td>{grid}</td>")),
+            "{grid}: {table}"
+        );
+    }
+    let shot = dir.path().join("shot.png");
+    let run = headless(
+        chromium,
+        &page,
+        &[
+            "--enable-logging=stderr",
+            "--v=0",
+            "--window-size=1200,3000",
+            &format!("--screenshot={}", shot.display()),
+        ],
+    );
+    let log = text(&run.stderr);
+    assert!(
+        !log.contains("CONSOLE") && !log.contains("Uncaught"),
+        "{log}"
+    );
+    let png = image::open(&shot).unwrap().to_rgb8();
+    let hatch = png.pixels().filter(|p| p.0 == [150, 150, 150]).count();
+    assert!(hatch > 50, "{hatch} pixels of the hatch in the screenshot");
+    let pdf = dir.path().join("report.pdf");
+    headless(
+        chromium,
+        &page,
+        &[
+            "--no-pdf-header-footer",
+            &format!("--print-to-pdf={}", pdf.display()),
+        ],
+    );
+    let bytes = std::fs::read(&pdf).unwrap();
+    assert!(bytes.starts_with(b"%PDF"));
+    let pages = bytes
+        .windows(11)
+        .filter(|w| w.starts_with(b"/Type /Page") && w[10] != b's')
+        .count()
+        + bytes
+            .windows(10)
+            .filter(|w| w.starts_with(b"/Type/Page") && w[9] != b's')
+            .count();
+    assert!(pages >= 5, "{pages} pages");
+}
