@@ -292,7 +292,7 @@ pub enum Command {
     /// a plot of error against time with the Pareto front and the path tracer's curve.
     Sweep(SweepArgs),
     /// Solve a scene and measure the illuminance on its grids ([[grid]]): per grid a CSV of
-    /// x,y,z,E, a false-colour plan (PNG) and a line with Emin, Eavg, Emax and the uniformity.
+    /// x,y,z,E,in_solid, an isolux plan (PNG) and a line with Emin, Eavg, Emax and the uniformity.
     Lux {
         #[command(flatten)]
         solve: SolveArgs,

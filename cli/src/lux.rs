@@ -1,5 +1,5 @@
 //! `meshlight lux`: solve, then measure illuminance at every grid's points; per grid a CSV
-//! (`x,y,z,E`), a false-colour plan, and a summary line.
+//! (`x,y,z,E,in_solid`), an isolux plan, and a summary line.
 
 use std::io::Write as _;
 use std::path::Path;
@@ -130,9 +130,9 @@ pub fn measure(
             std::fs::File::create(&csv)
                 .with_context(|| format!("{}: cannot write", csv.display()))?,
         );
-        writeln!(out, "x,y,z,E")?;
-        for (p, v) in points.iter().zip(&values) {
-            writeln!(out, "{},{},{},{v}", p.x, p.y, p.z)?;
+        writeln!(out, "x,y,z,E,in_solid")?;
+        for ((p, v), &solid) in points.iter().zip(&values).zip(&inside) {
+            writeln!(out, "{},{},{},{v},{}", p.x, p.y, p.z, u8::from(solid))?;
         }
         out.flush()?;
         let s = Summary::of(&open);

@@ -429,11 +429,11 @@ fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
     assert!(short.contains("short (-3"), "{short}");
     let csv = std::fs::read_to_string(out_dir.join("mid_plane.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
-    assert_eq!(rows[0], "x,y,z,E");
+    assert_eq!(rows[0], "x,y,z,E,in_solid");
     assert_eq!(rows.len(), 7);
     let e: Vec<f64> = rows[1..]
         .iter()
-        .map(|r| r.rsplit(',').next().unwrap().parse().unwrap())
+        .map(|r| r.split(',').nth(3).unwrap().parse().unwrap())
         .collect();
     let want = std::f64::consts::PI * 0.2;
     for v in &e {
@@ -796,18 +796,18 @@ fn headless(chromium: &str, page: &std::path::Path, args: &[&str]) -> Output {
 
 #[test]
 fn the_report_opens_in_headless_chromium_and_prints_a_page_per_section() {
-    // A real browser: the DOM it builds holds the grid table with every grid; a screenshot
-    // shows the plans (the box's hatch, grey 150, is drawn: the images decoded); nothing goes
-    // to the console; printed to PDF, each of the five sections starts a page.
+    // A real browser on the designed gallery's report: the DOM it builds holds the grid table
+    // with every grid, each with its Ēm within 0.1% of the mean of its CSV's points outside
+    // solids; a screenshot shows the plans (the pedestals' hatch, grey 150, is drawn: the
+    // images decoded); nothing goes to the console; printed to PDF, each of the five sections
+    // starts a page.
     let Some(chromium) = chromium() else { return };
-    let (dir, scene) = floor_scene(
-        "[[grid]]\nname = \"near the box\"\norigin = [0.5, 0.05, 3]\nu = [2, 0, 0]\n\
-         v = [0, 0, 1]\nnormal = [0, 1, 0]\nspacing = 0.25\ntarget_em = 1000\n",
-    );
+    meshlight_gallery::ensure().unwrap();
+    let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("report");
     let out = meshlight(&[
         "report",
-        scene.to_str().unwrap(),
+        "scenes/gallery/design.toml",
         "-o",
         out_dir.to_str().unwrap(),
     ]);
@@ -819,10 +819,28 @@ fn the_report_opens_in_headless_chromium_and_prints_a_page_per_section() {
         .nth(1)
         .and_then(|t| t.split("</table>").next())
         .unwrap_or_else(|| panic!("no grid table in the DOM:\n{dom}"));
-    for grid in ["floor", "near the box"] {
+    for (grid, csv) in [
+        ("room 1 work plane", "room_1_work_plane.csv"),
+        ("painting 1", "painting_1.csv"),
+        ("painting 2", "painting_2.csv"),
+    ] {
+        let row = table
+            .split("<tr data-em=\"")
+            .skip(1)
+            .find(|r| r.contains(&format!("<td>{grid}</td>")))
+            .unwrap_or_else(|| panic!("no row for {grid}: {table}"));
+        let em: f64 = row.split('"').next().unwrap().parse().unwrap();
+        let csv = std::fs::read_to_string(out_dir.join(csv)).unwrap();
+        let open: Vec<f64> = csv
+            .lines()
+            .skip(1)
+            .filter(|r| r.ends_with(",0"))
+            .map(|r| r.split(',').nth(3).unwrap().parse().unwrap())
+            .collect();
+        let mean = open.iter().sum::<f64>() / open.len() as f64;
         assert!(
-            table.contains(&format!("<td>{grid}</td>")),
-            "{grid}: {table}"
+            (em / mean - 1.0).abs() < 1e-3,
+            "{grid}: DOM {em}, CSV {mean}"
         );
     }
     let shot = dir.path().join("shot.png");
