@@ -147,10 +147,13 @@ fn report_command(
     })?;
     let view_path = output.join("view.png");
     image.write_png(&view_path, image.auto_exposure())?;
-    let view = std::fs::read(&view_path)?;
+    let false_path = output.join("view-luminance.png");
+    let luminance = FalseColor::Luminance;
+    false_colour_render(&image, &false_path, luminance, None, false, scene.units())?;
+    let views = vec![std::fs::read(&view_path)?, std::fs::read(&false_path)?];
     let rendering = t.elapsed().as_secs_f64();
     let extras = page::Extras {
-        view: Some(view),
+        views,
         summary: &summary,
         seconds: (solving, measuring, rendering),
     };

@@ -15,8 +15,9 @@ use super::plan::round_label;
 
 /// What the page shows besides the scene and its grids.
 pub struct Extras<'a> {
-    /// The rendered view as PNG bytes, with its exposure.
-    pub view: Option<Vec<u8>>,
+    /// The rendered view as PNG bytes: tone-mapped radiance, then its luminance in false
+    /// colour.
+    pub views: Vec<Vec<u8>>,
     /// The solve's summary as the command line printed it.
     pub summary: &'a str,
     /// Seconds the solve, the grids and the view took.
@@ -174,14 +175,21 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
     }
     writeln!(h, "</section>")?;
 
-    if let Some(view) = &extras.view {
-        writeln!(
-            h,
-            "<section id=\"views\"><h2>Rendered view</h2><figure><img alt=\"the scene's camera \
-             view\" src=\"data:image/png;base64,{}\"><figcaption>The camera's view, radiance \
-             tone-mapped to sRGB.</figcaption></figure></section>",
-            base64(view)
-        )?;
+    if !extras.views.is_empty() {
+        writeln!(h, "<section id=\"views\"><h2>Rendered view</h2>")?;
+        let captions = [
+            "The camera's view, radiance tone-mapped to sRGB.",
+            "The same view's luminance in false colour.",
+        ];
+        for (view, caption) in extras.views.iter().zip(captions) {
+            writeln!(
+                h,
+                "<figure><img alt=\"{caption}\" src=\"data:image/png;base64,{}\">\
+                 <figcaption>{caption}</figcaption></figure>",
+                base64(view)
+            )?;
+        }
+        writeln!(h, "</section>")?;
     }
 
     let (solve, measure, view) = extras.seconds;

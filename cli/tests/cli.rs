@@ -728,7 +728,11 @@ fn report_writes_one_self_contained_page_with_every_grid_and_its_targets() {
         }
     }
     let images: Vec<&str> = html.split("src=\"data:image/png;base64,").skip(1).collect();
-    assert_eq!(images.len(), 3, "two plans and the view");
+    assert_eq!(
+        images.len(),
+        4,
+        "two plans and the view in radiance and false colour"
+    );
     for b64 in images {
         let bytes = decode_base64(b64.split('"').next().unwrap());
         assert!(image::load_from_memory(&bytes).is_ok());
