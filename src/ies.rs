@@ -28,6 +28,10 @@ pub struct Photometry {
     pub candela: Vec<f64>,
     /// Whether the file says absolute photometry (lumens per lamp = −1).
     pub absolute: bool,
+    /// Where it came from: the IES file's name, or what made it (a glTF spot).
+    pub source: String,
+    /// The input watts the file gives (none when it says 0).
+    pub input_watts: Option<f64>,
     /// [`Photometry::flux`], integrated once.
     flux: std::sync::OnceLock<f64>,
 }
@@ -188,7 +192,7 @@ impl Photometry {
         };
         let ballast = factor("the ballast factor")?;
         let ballast_lamp = factor("the ballast-lamp photometric factor")?;
-        numbers.number("the input watts")?;
+        let (input_watts, _) = numbers.number("the input watts")?;
         let vertical = numbers.angles("vertical angles", nv)?;
         let horizontal = numbers.angles("horizontal angles", nh)?;
         let (v0, v1) = (vertical[0], vertical[nv - 1]);
@@ -244,18 +248,28 @@ impl Photometry {
             horizontal,
             candela,
             absolute: lumens == -1.0,
+            source: path
+                .file_name()
+                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned()),
+            input_watts: (input_watts.is_finite() && input_watts > 0.0).then_some(input_watts),
             flux: std::sync::OnceLock::new(),
         })
     }
 
     /// A distribution symmetric about its axis: candela `candela[i]` at γ = `vertical[i]`
     /// (degrees, increasing from 0 to at most 180), none beyond the last angle.
-    pub(crate) fn symmetric(vertical: Vec<f64>, candela: Vec<f64>) -> Photometry {
+    pub(crate) fn symmetric(
+        source: String,
+        vertical: Vec<f64>,
+        candela: Vec<f64>,
+    ) -> Photometry {
         Photometry {
             vertical,
             horizontal: vec![0.0],
             candela,
             absolute: true,
+            source,
+            input_watts: None,
             flux: std::sync::OnceLock::new(),
         }
     }

@@ -78,15 +78,31 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
             round_label(v.z.into())
         )
     };
-    for (i, l) in scene.luminaires().iter().enumerate() {
-        let f = luminance(l.flux().as_vec3());
+    // Luminaires of one file (and one tint) in one row: how many, where, and each one's flux.
+    let mut kinds: Vec<(String, Vec<&meshlight::scene::Luminaire>)> = Vec::new();
+    for l in scene.luminaires() {
+        let key = format!("{}|{:?}", l.photometry.source, l.tint);
+        match kinds.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, ls)) => ls.push(l),
+            None => kinds.push((key, vec![l])),
+        }
+    }
+    for (_, ls) in &kinds {
+        let first = ls[0];
+        let watts = first
+            .photometry
+            .input_watts
+            .map_or(String::new(), |w| format!(", {} W input each", round_label(w)));
+        let at: Vec<String> = ls.iter().map(|l| format!("({})", v3(l.position))).collect();
+        let aims: Vec<String> = ls.iter().map(|l| format!("({})", v3(l.aim))).collect();
         writeln!(
             h,
-            "<tr><td>luminaire {}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            i + 1,
-            v3(l.position),
-            v3(l.aim),
-            round_label(f.into())
+            "<tr><td>{} × {}{watts}</td><td>{}</td><td>{}</td><td>{} each</td></tr>",
+            ls.len(),
+            escape(&first.photometry.source),
+            at.join("<br>"),
+            aims.join("<br>"),
+            round_label(luminance(first.flux().as_vec3()).into())
         )?;
     }
     for (i, l) in scene.point_lights().iter().enumerate() {

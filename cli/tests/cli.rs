@@ -818,6 +818,8 @@ fn the_report_opens_in_headless_chromium_and_prints_a_page_per_section() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     let page = out_dir.join("index.html");
     let dom = text(&headless(chromium, &page, &["--dump-dom"]).stdout);
+    // The schedule: the design's eight downlights and three wall-washers, by file.
+    assert!(dom.contains("<td>8 × downlight.ies") && dom.contains("<td>3 × wallwasher.ies"));
     let table = dom
         .split("<table id=\"grid-table\">")
         .nth(1)

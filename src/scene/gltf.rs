@@ -549,7 +549,12 @@ fn spot_cone(inner: f32, outer: f32, falloff: Falloff) -> crate::ies::Photometry
     }
     vertical.push(180.0);
     candela.push(0.0);
-    crate::ies::Photometry::symmetric(vertical, candela)
+    let source = format!(
+        "glTF spot, cones {:.1}° and {:.1}°",
+        inner.to_degrees(),
+        outer.to_degrees()
+    );
+    crate::ies::Photometry::symmetric(source, vertical, candela)
 }
 
 /// A glTF image as a texture: from a buffer view, a `data:` URI, or a file beside the glTF.
