@@ -248,9 +248,10 @@ impl Photometry {
             horizontal,
             candela,
             absolute: lumens == -1.0,
-            source: path
-                .file_name()
-                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned()),
+            source: path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            ),
             input_watts: (input_watts.is_finite() && input_watts > 0.0).then_some(input_watts),
             flux: std::sync::OnceLock::new(),
         })
@@ -258,11 +259,7 @@ impl Photometry {
 
     /// A distribution symmetric about its axis: candela `candela[i]` at γ = `vertical[i]`
     /// (degrees, increasing from 0 to at most 180), none beyond the last angle.
-    pub(crate) fn symmetric(
-        source: String,
-        vertical: Vec<f64>,
-        candela: Vec<f64>,
-    ) -> Photometry {
+    pub(crate) fn symmetric(source: String, vertical: Vec<f64>, candela: Vec<f64>) -> Photometry {
         Photometry {
             vertical,
             horizontal: vec![0.0],

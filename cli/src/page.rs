@@ -89,10 +89,9 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
     }
     for (_, ls) in &kinds {
         let first = ls[0];
-        let watts = first
-            .photometry
-            .input_watts
-            .map_or(String::new(), |w| format!(", {} W input each", round_label(w)));
+        let watts = first.photometry.input_watts.map_or(String::new(), |w| {
+            format!(", {} W input each", round_label(w))
+        });
         let at: Vec<String> = ls.iter().map(|l| format!("({})", v3(l.position))).collect();
         let aims: Vec<String> = ls.iter().map(|l| format!("({})", v3(l.aim))).collect();
         writeln!(
