@@ -11,6 +11,13 @@ fn meshlight(args: &[&str]) -> Output {
         .expect("run meshlight")
 }
 
+/// `meshlight` with `args`, which must succeed (its stderr says why not).
+fn succeed(args: &[&str]) -> Output {
+    let out = meshlight(args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    out
+}
+
 /// A path from the workspace root, where the shipped scenes are.
 fn root(path: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -24,8 +31,7 @@ fn text(bytes: &[u8]) -> String {
 
 #[test]
 fn info_summarises_the_room() {
-    let out = meshlight(&["info", "scenes/room/scene.toml"]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = succeed(&["info", "scenes/room/scene.toml"]);
     let stdout = text(&out.stdout);
     for expected in [
         "triangles     34",
@@ -70,7 +76,7 @@ fn unknown_backend_is_refused() {
 
 #[test]
 fn bench_vis_prints_rates_for_every_backend_and_their_agreement() {
-    let out = meshlight(&[
+    let out = succeed(&[
         "bench-vis",
         "scenes/room/scene.toml",
         "--queries",
@@ -80,7 +86,6 @@ fn bench_vis_prints_rates_for_every_backend_and_their_agreement() {
         "--repeats",
         "1",
     ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
     assert!(stdout.contains("20000 occlusion segments"), "{stdout}");
     assert!(stdout.contains("bvh thorough-wide"), "{stdout}");
@@ -113,8 +118,7 @@ fn gallery_generator_writes_a_loadable_reduced_gallery() {
         },
     )
     .unwrap();
-    let out = meshlight(&["info", path.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = succeed(&["info", path.to_str().unwrap()]);
     assert!(
         text(&out.stdout).contains("point lights  8"),
         "{}",
@@ -404,13 +408,12 @@ fn lux_writes_a_csv_and_a_plan_per_grid_and_summarises_them() {
         + "\n[[grid]]\nname = \"asks too much\"\norigin = [0.2, 0.3, 0.2]\nu = [0.6, 0, 0]\nv = [0, 0, 0.4]\nspacing = 0.2\ntarget_em = 1.0\n";
     std::fs::write(&scene, toml).unwrap();
     let out_dir = dir.path().join("lux");
-    let out = meshlight(&[
+    let out = succeed(&[
         "lux",
         scene.to_str().unwrap(),
         "-o",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
     let line = stdout
         .lines()
@@ -458,7 +461,7 @@ fn false_colour_renders_hold_the_illuminance_and_refuse_bad_ranges() {
     // The furnace: every surface receives E = π · 0.2 (radiance 0.2 from all round).
     let dir = tempfile::tempdir().unwrap();
     let exr = dir.path().join("e.exr");
-    let out = meshlight(&[
+    succeed(&[
         "render",
         "scenes/box/scene.toml",
         "-o",
@@ -466,7 +469,6 @@ fn false_colour_renders_hold_the_illuminance_and_refuse_bad_ranges() {
         "--false-color",
         "illuminance",
     ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let image = meshlight::Image::read_exr(&exr).unwrap();
     let want = std::f64::consts::PI * 0.2;
     assert!(
@@ -546,7 +548,7 @@ fn a_scene_without_light_is_refused_and_a_light_facing_the_ceiling_is_named() {
     let up = dir.path().join("up.toml");
     std::fs::write(&up, &scene).unwrap();
     let exr = dir.path().join("up.exr");
-    let out = meshlight(&[
+    let out = succeed(&[
         "render",
         up.to_str().unwrap(),
         "--preset",
@@ -554,7 +556,6 @@ fn a_scene_without_light_is_refused_and_a_light_facing_the_ceiling_is_named() {
         "-o",
         exr.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let stderr = text(&out.stderr);
     assert!(
         stderr.contains("warning: the area light") && stderr.contains("material 'light'"),
@@ -602,13 +603,12 @@ fn lux_plans_trace_iso_lines_on_a_point_lights_circles_and_hatch_solids() {
     // Points inside the box are hatched grey, never the colour of 0 lx.
     let (dir, scene) = floor_scene("");
     let out_dir = dir.path().join("lux");
-    let out = meshlight(&[
+    succeed(&[
         "lux",
         scene.to_str().unwrap(),
         "-o",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let png = image::open(out_dir.join("floor.png")).unwrap().to_rgb8();
     // Floor metres (x along u, z along v) to pixels: v runs up the picture.
     let pixel = |x: f64, z: f64| (52.0 + 48.0 * x, 10.0 + 480.0 - 48.0 * z);
@@ -689,13 +689,12 @@ fn report_writes_one_self_contained_page_with_every_grid_and_its_targets() {
          v = [0, 0, 1]\nnormal = [0, 1, 0]\nspacing = 0.25\ntarget_em = 1000\ntarget_u0 = 0.5\n",
     );
     let out_dir = dir.path().join("report");
-    let out = meshlight(&[
+    succeed(&[
         "report",
         scene.to_str().unwrap(),
         "-o",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let html = std::fs::read_to_string(out_dir.join("index.html")).unwrap();
     assert!(!html.contains("<script") && !html.contains("http://") && !html.contains("https://"));
     for (grid, csv) in [("floor", "floor.csv"), ("near the box", "near_the_box.csv")] {
@@ -809,13 +808,12 @@ fn the_report_opens_in_headless_chromium_and_prints_a_page_per_section() {
     meshlight_gallery::ensure().unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("report");
-    let out = meshlight(&[
+    succeed(&[
         "report",
         "scenes/gallery/design.toml",
         "-o",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
     let page = out_dir.join("index.html");
     let dom = text(&headless(chromium, &page, &["--dump-dom"]).stdout);
     // The schedule: the design's eight downlights and three wall-washers, by file.

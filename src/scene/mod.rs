@@ -557,7 +557,10 @@ impl Scene {
         let mut warnings = Vec::new();
         let mut mesh = mesh;
         if two_sided::any(&mesh) {
-            let diagonal = two_sided::diagonal(&mesh);
+            let used = mesh.triangles.iter().flatten();
+            let diagonal =
+                Bounds::around(used.filter_map(|&i| mesh.positions.get(i as usize).copied()))
+                    .diagonal();
             if diagonal.is_finite() && diagonal > 0.0 {
                 two_sided::split(&mut mesh, diagonal);
             }

@@ -9,8 +9,6 @@
 //! by [`SEPARATION`] so that a ray from either side meets the sheet facing it first; coincident
 //! sheets would leave the ray caster to pick one at random, and the back of the other is black.
 
-use glam::Vec3;
-
 use super::Mesh;
 
 /// How far apart the two sheets are, as a fraction of the scene's diagonal: a tenth of the
@@ -61,22 +59,11 @@ pub(super) fn any(mesh: &Mesh) -> bool {
     mesh.materials.iter().any(|m| m.two_sided && m.is_emitter())
 }
 
-/// The diagonal of the box around the vertices the triangles use.
-pub(super) fn diagonal(mesh: &Mesh) -> f32 {
-    let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-    for &i in mesh.triangles.iter().flatten() {
-        if let Some(&p) = mesh.positions.get(i as usize) {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-    }
-    (hi - lo).length()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::Material;
+    use glam::Vec3;
 
     #[test]
     fn a_two_sided_emitter_becomes_two_sheets_facing_away_from_each_other() {
