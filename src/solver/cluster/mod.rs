@@ -273,7 +273,10 @@ fn sweep(
         inputs.scales.extend_from_slice(scales);
     };
     with_pool(settings.threads.max(1), settings.capacity, &work, |pool| {
-        // Row sums: one sweep with unit radiosity everywhere, unscaled.
+        // Row sums: one sweep with unit radiosity everywhere, unscaled. Each sample's normalised
+        // row sum is by reciprocity also the share of what it shoots that the links should
+        // deliver (see `balance`).
+        let mut rows = Vec::new();
         if settings.normalise {
             set(&vec![DVec3::ONE; n], &[]);
             let mut kept = Vec::with_capacity(groups.len());
@@ -290,6 +293,15 @@ fn sweep(
             for (i, scale) in state.row_scale.iter_mut().enumerate() {
                 *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
             }
+            // Only cluster links need it: with sample-to-sample links alone (threshold 0) the
+            // transport is the flat solver's, and stays so.
+            if stats.links > stats.leaf_links {
+                rows = sums
+                    .iter()
+                    .zip(state.row_scale.iter())
+                    .map(|(&sum, &scale)| sum * f64::from(scale))
+                    .collect();
+            }
         }
 
         let max_sweeps = if settings.max_shots == u64::MAX {
@@ -298,6 +310,7 @@ fn sweep(
             settings.max_shots
         };
         let mut first = true;
+        let mut last_shot = None;
         loop {
             let total: f64 = (0..n)
                 .map(|k| unshot_power(state.unshot[k], samples.area[k]))
@@ -333,22 +346,41 @@ fn sweep(
             // Every sample shoots its unshot radiosity along the links.
             set(state.unshot, state.row_scale);
             let shot: DVec3 = (0..n).map(|k| state.unshot[k] * samples.area[k]).sum();
+            let owed: DVec3 = if rows.is_empty() {
+                DVec3::ZERO
+            } else {
+                (0..n)
+                    .map(|k| state.unshot[k] * (samples.area[k] * rows[k]))
+                    .sum()
+            };
             let mut delivered = DVec3::ZERO;
             let mut kept = Vec::with_capacity(groups.len());
-            let (irradiance, unshot) = (&mut *state.irradiance, &mut *state.unshot);
-            let reflectance = state.reflectance;
             pool.run_all(groups.drain(..), |_, group| {
                 let first = first_member(tree, group.root);
                 for (p, &h) in group.delivered.iter().enumerate() {
-                    let k = tree.order[first + p] as usize;
-                    irradiance[k] += h;
-                    unshot[k] = reflectance[k] * h;
-                    delivered += h * samples.area[k];
+                    delivered += h * samples.area[tree.order[first + p] as usize];
                 }
                 kept.push(group);
                 Ok(())
             })?;
             groups = kept;
+            let factor = if rows.is_empty() {
+                DVec3::ONE
+            } else {
+                balance(owed, delivered)
+            };
+            delivered *= factor;
+            let (irradiance, unshot) = (&mut *state.irradiance, &mut *state.unshot);
+            let reflectance = state.reflectance;
+            for group in &groups {
+                let first = first_member(tree, group.root);
+                for (p, &h) in group.delivered.iter().enumerate() {
+                    let k = tree.order[first + p] as usize;
+                    let h = h * factor;
+                    irradiance[k] += h;
+                    unshot[k] = reflectance[k] * h;
+                }
+            }
             // And by way of specular surfaces: G applied to what was shot.
             if let Some(g) = state.specular {
                 let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
@@ -361,10 +393,104 @@ fn sweep(
             }
             state.ledger.escaped += shot - delivered;
             stats.shots += 1;
+            last_shot = Some(shot);
+        }
+        if stats.stop == StopReason::Converged {
+            if let Some(shot) = last_shot {
+                tail(state, shot);
+            }
         }
         Ok(())
     })?;
     Ok(groups)
+}
+
+/// Reflections beyond this share per sweep are not extrapolated (the tail's factor r/(1 − r)
+/// would be 99 or more, on a ratio measured from one sweep).
+const TAIL_LIMIT: f64 = 0.99;
+
+/// The light still unshot when the sweeps stop, carried on to its end: sweeps shoot every
+/// sample at once, so their unshot power settles into one shape that shrinks by a ratio r per
+/// sweep (the iteration's dominant eigenvector), and what the remaining sweeps would add to
+/// sample k's irradiance is its last increment h_k times r + r² + … = r/(1 − r), with h_k =
+/// ΔB_k / ρ_k. At the default tolerance a thousandth of the emitted power is left, which at
+/// albedo 0.95 would have been reflected about 20 more times (−0.1% of the image on a
+/// Cornell-like room at Kd 0.95). Unshot power is then spent: a later round's warm start must
+/// not shoot it again. The ledger books the tail's shots (U/(1 − r)) less what they deliver as
+/// escaped, so that it still adds up.
+fn tail(state: &mut State, shot: DVec3) {
+    let samples = state.samples;
+    let n = samples.len();
+    let left: DVec3 = (0..n).map(|k| state.unshot[k] * samples.area[k]).sum();
+    let ratio = |u: f64, s: f64| {
+        let r = u / s;
+        if u > 0.0 && s > 0.0 && r < TAIL_LIMIT {
+            r
+        } else {
+            0.0
+        }
+    };
+    let r = DVec3::new(
+        ratio(left.x, shot.x),
+        ratio(left.y, shot.y),
+        ratio(left.z, shot.z),
+    );
+    if r == DVec3::ZERO {
+        return;
+    }
+    let factor = r / (DVec3::ONE - r);
+    let mut delivered = DVec3::ZERO;
+    for k in 0..n {
+        let rho = state.reflectance[k];
+        let unshot = state.unshot[k];
+        let h = DVec3::new(
+            if rho.x > 0.0 { unshot.x / rho.x } else { 0.0 },
+            if rho.y > 0.0 { unshot.y / rho.y } else { 0.0 },
+            if rho.z > 0.0 { unshot.z / rho.z } else { 0.0 },
+        ) * factor;
+        state.irradiance[k] += h;
+        delivered += h * samples.area[k];
+        // Spent where extrapolated; a channel without a tail keeps its unshot power.
+        state.unshot[k] = DVec3::select(r.cmpgt(DVec3::ZERO), DVec3::ZERO, unshot);
+    }
+    let spent = DVec3::select(r.cmpgt(DVec3::ZERO), left, DVec3::ZERO);
+    state.ledger.escaped += spent * (DVec3::ONE + factor) - delivered;
+}
+
+/// Corrections larger than this are not the cluster formula's error but something the rows
+/// do not see (a sweep of mixed-sign warm-start power nearly cancelling, say): left alone.
+const BALANCE_LIMIT: f64 = 0.1;
+
+/// The factor (per channel) that makes up what a sweep's links fail to deliver of what its
+/// shooters owe: each sample's share of its own shot is its normalised row sum (reciprocity:
+/// A_k Σⱼ F_kj = Σⱼ A_j F_jk), so `owed` = Σ ΔB_k A_k row_k. Cluster links lose light the
+/// exact form factors would deliver (faint partly visible links carry their probes' share, and
+/// the far-field formula errs at second order near the admissible distance), and at high albedo
+/// the loss compounds sweep after sweep: on a Cornell-like room at Kd 0.95 the links delivered
+/// 0.46% less than the flat solver's and the image was 0.5% darker, evenly. Scaling the whole
+/// sweep, rather than each shooter's links by a factor fixed in advance, holds for whatever
+/// unshot power the sweep carries (fixed column factors, measured with unit radiosity,
+/// created energy from concentrated power).
+///
+/// Never below 1: a sweep that delivers more than its rows owe is not scaled down. The rows
+/// are not exact either (the flat solver's point-to-disc factors deliver 0.1% more than its
+/// rows on that room, and that image is the closer to the path tracer), and on the gallery,
+/// where the hierarchy delivers 0.3% more than its rows, scaling down took the image from
+/// −0.1% to −0.5% against the path tracer.
+fn balance(owed: DVec3, delivered: DVec3) -> DVec3 {
+    let one = |o: f64, d: f64| {
+        let f = o / d;
+        if o > 0.0 && d > 0.0 && (1.0..=1.0 + BALANCE_LIMIT).contains(&f) {
+            f
+        } else {
+            1.0
+        }
+    };
+    DVec3::new(
+        one(owed.x, delivered.x),
+        one(owed.y, delivered.y),
+        one(owed.z, delivered.z),
+    )
 }
 
 fn first_member(tree: &Tree, r: Ref) -> usize {
