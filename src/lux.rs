@@ -284,7 +284,8 @@ impl SpecularGather<'_> {
                     .map(|&(k, w)| reflected[k as usize] * f64::from(w))
                     .sum::<DVec3>()
                     / total;
-                out[e.receiver as usize] += e.weight * b;
+                // A local-linear fit may extrapolate below zero near a dark edge.
+                out[e.receiver as usize] += e.weight * b.max(DVec3::ZERO);
             }
         }
         Ok(out)

@@ -2,10 +2,11 @@
 //! the point's side whose kernels reach it, weighted by the compactly supported kernel
 //! (1 − d²/r²)³ with r = 2D, among those in sight of it (a sample behind a wall on the same
 //! continuous side never contributes) and covered as the point is (`sampling::cover`), if any
-//! such; where no kernel reaches a point in sight, its nearest visible sample. Shared by the
-//! camera's hits, the points specular chains end at, and the grids.
+//! such, and turned into the weights of a local-linear fit ([`local_linear`]); where no kernel
+//! reaches a point in sight, its nearest visible sample. Shared by the camera's hits, the
+//! points specular chains end at, and the grids.
 
-use glam::Vec3;
+use glam::{DVec2, Vec3};
 
 use crate::error::Result;
 use crate::sampling::{cover, is_back, surface_of, Side};
@@ -34,6 +35,9 @@ pub(crate) struct Interpolator<'a> {
     lift: f32,
     /// Largest kernel support among each side's samples (0: the side has none).
     support: Vec<f32>,
+    /// Whether weights are those of a local-linear fit (see [`local_linear`]); plain kernel
+    /// weights (all positive) where they enter the solve as transport.
+    linear: bool,
 }
 
 impl<'a> Interpolator<'a> {
@@ -48,7 +52,15 @@ impl<'a> Interpolator<'a> {
             vis,
             lift: crate::visibility::lift(scene),
             support,
+            linear: true,
         }
+    }
+
+    /// The same, with plain (positive) kernel weights: for weights that become transport in
+    /// the solve, where a negative entry could create light.
+    pub(crate) fn plain(mut self) -> Self {
+        self.linear = false;
+        self
     }
 
     /// Whether a side has samples to interpolate.
@@ -111,6 +123,7 @@ impl<'a> Interpolator<'a> {
             .map(|s| s.is_some() && answer.next().unwrap_or(false))
             .collect();
         out.clear();
+        let mut offsets = Vec::new();
         for (site, range) in sites.iter().zip(ranges) {
             // Samples covered as the site is; any visible one if there is none such.
             let mut chosen = Vec::new();
@@ -129,6 +142,20 @@ impl<'a> Interpolator<'a> {
                 let (nearest, q) = self.nearest_visible(site.side, site.point)?;
                 queries += q;
                 chosen.extend(nearest.map(|k| (k, 1.0)));
+            } else if self.linear {
+                let map = &self.solution.maps[surface_of(site.side) as usize];
+                let at = map.to_2d(site.point);
+                // Each value is its region's average, which a linear field takes at the
+                // region's centroid: the fit places the values there.
+                offsets.clear();
+                offsets.extend(chosen.iter().map(|&(k, _)| {
+                    let p = s
+                        .centroid
+                        .get(k as usize)
+                        .unwrap_or(&s.position[k as usize]);
+                    (map.to_2d(*p) - at).as_dvec2()
+                }));
+                local_linear(&offsets, &mut chosen);
             }
             out.push(chosen);
         }
@@ -176,5 +203,140 @@ impl<'a> Interpolator<'a> {
             }
         }
         Ok((None, queries))
+    }
+}
+
+/// How far the local-linear weights may stray from an average: the sum of their magnitudes
+/// is at most this (1 is a plain weighted average).
+const SPREAD: f64 = 2.0;
+
+/// Turns kernel weights into those of a local-linear fit evaluated at the point, given each
+/// sample's offset from it in the side's plane: a field varying linearly over the kernels is
+/// then reproduced where the samples all lie on one side of the point (near an edge or a
+/// contact), where a weighted average returns the field at the samples' weighted centroid,
+/// inward of the point. The weights still add up to 1; where the fit would amplify the
+/// samples' differences more than [`SPREAD`] allows (samples nearly in a line, or the point
+/// far outside them) it is blended toward the average just enough.
+fn local_linear(offsets: &[DVec2], chosen: &mut [(u32, f32)]) {
+    if chosen.len() < 3 {
+        return;
+    }
+    let total: f64 = chosen.iter().map(|&(_, w)| f64::from(w)).sum();
+    if total.is_nan() || total <= 0.0 {
+        return;
+    }
+    let share = |w: f32| f64::from(w) / total;
+    let mean: DVec2 = chosen
+        .iter()
+        .zip(offsets)
+        .map(|(&(_, w), &d)| share(w) * d)
+        .sum();
+    let (mut xx, mut xy, mut yy) = (0.0, 0.0, 0.0);
+    for (&(_, w), &d) in chosen.iter().zip(offsets) {
+        let d = d - mean;
+        xx += share(w) * d.x * d.x;
+        xy += share(w) * d.x * d.y;
+        yy += share(w) * d.y * d.y;
+    }
+    // A little ridge keeps samples in a line (a narrow strip) from an unbounded slope.
+    let ridge = 1e-3 * (xx + yy);
+    let (xx, yy) = (xx + ridge, yy + ridge);
+    let det = xx * yy - xy * xy;
+    if !(det > 0.0 && det.is_finite()) {
+        return;
+    }
+    // The fit's value at the point: l_k = c_k (1 − mean·C⁻¹(d_k − mean)), C the weighted
+    // covariance of the offsets.
+    let g = DVec2::new(yy * mean.x - xy * mean.y, xx * mean.y - xy * mean.x) / det;
+    let fitted = |w: f32, d: DVec2| share(w) * (1.0 - g.dot(d - mean));
+    let spread: f64 = chosen
+        .iter()
+        .zip(offsets)
+        .map(|(&(_, w), &d)| fitted(w, d).abs())
+        .sum();
+    if !spread.is_finite() {
+        return;
+    }
+    let blend = if spread > SPREAD {
+        (SPREAD - 1.0) / (spread - 1.0)
+    } else {
+        1.0
+    };
+    for ((_, w), &d) in chosen.iter_mut().zip(offsets) {
+        *w = (blend * fitted(*w, d) + (1.0 - blend) * share(*w)) as f32;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Offsets and kernel weights of samples on one side of the point (as at a surface's
+    /// edge), in a deterministic scatter.
+    fn one_sided() -> (Vec<DVec2>, Vec<(u32, f32)>) {
+        let offsets: Vec<DVec2> = (0..12)
+            .map(|i| {
+                let a = 0.7 * i as f64;
+                DVec2::new(0.05 + 0.3 * (a.sin() * 0.5 + 0.5), 0.4 * a.cos())
+            })
+            .collect();
+        let weights = offsets
+            .iter()
+            .enumerate()
+            .map(|(k, d)| (k as u32, (1.0 - d.length_squared() / 0.5).powi(3) as f32))
+            .collect();
+        (offsets, weights)
+    }
+
+    #[test]
+    fn a_linear_field_is_reproduced_at_an_edge() {
+        let (offsets, mut weights) = one_sided();
+        let field = |d: DVec2| 2.0 + 3.0 * d.x - 1.5 * d.y;
+        let average: f64 = {
+            let t: f64 = weights.iter().map(|&(_, w)| f64::from(w)).sum();
+            weights
+                .iter()
+                .zip(&offsets)
+                .map(|(&(_, w), &d)| f64::from(w) / t * field(d))
+                .sum()
+        };
+        local_linear(&offsets, &mut weights);
+        let fitted: f64 = weights
+            .iter()
+            .zip(&offsets)
+            .map(|(&(_, w), &d)| f64::from(w) * field(d))
+            .sum();
+        let sum: f64 = weights.iter().map(|&(_, w)| f64::from(w)).sum();
+        // The field at the point is 2; the plain average reads it inward, where it is higher.
+        assert!(
+            average > 2.3,
+            "the average {average} should be biased inward"
+        );
+        assert!((sum - 1.0).abs() < 1e-6, "weights add up to {sum}");
+        let spread: f64 = weights.iter().map(|&(_, w)| f64::from(w).abs()).sum();
+        // Within the bound, so not blended: the fit is exact but for the ridge's 0.1%.
+        assert!(spread < SPREAD, "spread {spread}");
+        assert!(
+            (fitted - 2.0).abs() < 0.01 * (average - 2.0),
+            "fitted {fitted}"
+        );
+    }
+
+    #[test]
+    fn the_weights_never_spread_beyond_the_bound() {
+        // Samples nearly in a line, the point off it: the fit alone would extrapolate far.
+        let offsets: Vec<DVec2> = (0..6)
+            .map(|i| DVec2::new(1.0 + 1e-3 * (i % 2) as f64, -0.5 + 0.2 * i as f64))
+            .collect();
+        let mut weights: Vec<(u32, f32)> = (0..6).map(|k| (k, 1.0)).collect();
+        local_linear(&offsets, &mut weights);
+        let spread: f64 = weights.iter().map(|&(_, w)| f64::from(w).abs()).sum();
+        let sum: f64 = weights.iter().map(|&(_, w)| f64::from(w)).sum();
+        assert!(spread <= SPREAD + 1e-5, "spread {spread}");
+        assert!((sum - 1.0).abs() < 1e-5, "sum {sum}");
+        // Two samples: nothing to fit, the weights are left alone.
+        let mut two = vec![(0, 0.3), (1, 0.7)];
+        local_linear(&offsets[..2], &mut two);
+        assert_eq!(two, vec![(0, 0.3), (1, 0.7)]);
     }
 }

@@ -395,6 +395,8 @@ struct Shader<'a> {
     full: Vec<glam::DVec3>,
     /// Direct light traced at the hits, when the pixels take theirs from there.
     light: Option<DirectLight>,
+    /// The same with [`PENUMBRA_RAYS`] times the rays, for hits in a penumbra.
+    penumbra: Option<DirectLight>,
     /// How camera paths go on through specular surfaces (none: the scene has none).
     paths: Option<paths::Paths>,
     lift: f32,
@@ -404,6 +406,12 @@ struct Shader<'a> {
 
 /// Seed of the shadow rays traced at camera hits: a fixed one, so a render repeats.
 const DIRECT_SEED: u64 = 0x6d65_7368_6c69_6768;
+/// The seed of the second look at hits in a penumbra.
+const PENUMBRA_SEED: u64 = 0x7065_6e75_6d62_7261;
+/// A hit whose shadow rays disagree (some blocked, some not: it lies in a penumbra) is traced
+/// again with this many times the rays, and keeps that answer: the noise of a few rays is
+/// there and only there, so the extra rays go where they matter.
+const PENUMBRA_RAYS: u32 = 4;
 
 /// A hit waiting for its interpolation.
 #[derive(Clone)]
@@ -469,6 +477,16 @@ impl<'a> Shader<'a> {
             })
             .collect();
         let full = (0..s.len()).map(|k| shown(k, glam::DVec3::ZERO)).collect();
+        let penumbra = match options.direct {
+            Direct::Traced { light_samples } if light.is_some() => {
+                Some(DirectLight::with_specular(
+                    scene,
+                    (light_samples * PENUMBRA_RAYS).min(crate::light::MAX_LIGHT_SAMPLES),
+                    solution.specular_depth,
+                ))
+            }
+            _ => None,
+        };
         Shader {
             scene,
             vis,
@@ -477,6 +495,7 @@ impl<'a> Shader<'a> {
             values,
             full,
             light,
+            penumbra,
             paths: {
                 let spec = crate::specular::Specular::of(scene);
                 (spec.any() && solution.specular_depth > 0).then(|| paths::Paths {
@@ -606,8 +625,9 @@ impl<'a> Shader<'a> {
                         wsum += f64::from(w);
                         sum += f64::from(w) * values[k as usize];
                     }
+                    // A local-linear fit may extrapolate below zero near a dark edge.
                     let interpolated = if wsum > 0.0 {
-                        (sum / wsum).as_vec3()
+                        (sum / wsum).as_vec3().max(Vec3::ZERO)
                     } else {
                         Vec3::ZERO
                     };
@@ -645,7 +665,19 @@ impl<'a> Shader<'a> {
             .collect();
         let ids: Vec<u32> = lit.iter().map(|&i| pending[i].id).collect();
         let mut arrivals = vec![crate::light::Arrival::default(); lit.len()];
-        let queries = light.batch(self.vis, &points, &ids, DIRECT_SEED, &mut arrivals)?;
+        let mut queries = light.batch(self.vis, &points, &ids, DIRECT_SEED, &mut arrivals)?;
+        if let Some(penumbra) = &self.penumbra {
+            let partial: Vec<usize> = (0..arrivals.len())
+                .filter(|&i| (1e-4..1.0 - 1e-4).contains(&arrivals[i].visible))
+                .collect();
+            let points: Vec<(Vec3, Vec3)> = partial.iter().map(|&i| points[i]).collect();
+            let ids: Vec<u32> = partial.iter().map(|&i| ids[i]).collect();
+            let mut again = vec![crate::light::Arrival::default(); partial.len()];
+            queries += penumbra.batch(self.vis, &points, &ids, PENUMBRA_SEED, &mut again)?;
+            for (&i, a) in partial.iter().zip(again) {
+                arrivals[i] = a;
+            }
+        }
         for (&i, arrival) in lit.iter().zip(&arrivals) {
             let e = arrival.irradiance;
             shown[i] = match self.quantity {

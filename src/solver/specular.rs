@@ -102,7 +102,7 @@ impl Transfer {
     ) -> Result<u64> {
         let s = &solution.samples;
         let n = s.len();
-        let interpolator = Interpolator::new(scene, solution, vis);
+        let interpolator = Interpolator::new(scene, solution, vis).plain();
         let points: Vec<(Vec3, Vec3)> = self.ends.iter().map(|e| (e.point, e.normal)).collect();
         let covered = interpolator.covered(&points)?;
         let sites: Vec<Site> = self
