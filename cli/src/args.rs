@@ -44,6 +44,10 @@ pub struct Knobs {
     /// Start from a preset: preview, default or final.
     #[arg(long, default_value = "default")]
     pub preset: String,
+    /// Multiplies the ε from the scene file or the automatic choice (not `--epsilon`), 1/16 to
+    /// 16 [default: the preset's: 1, final 0.5].
+    #[arg(long)]
+    pub epsilon_scale: Option<f32>,
     /// Adaptive error threshold ζ, relative to the mean radiosity.
     #[arg(long)]
     pub zeta: Option<f32>,
@@ -141,14 +145,16 @@ pub struct RenderArgs {
     /// Output image (.exr); the PNG gets the same name with .png.
     #[arg(short, long, default_value = "out.exr")]
     pub output: PathBuf,
-    /// Rays per side on pixels that straddle an edge (1 = one ray per pixel).
-    #[arg(long, default_value_t = 4)]
-    pub supersample: u32,
+    /// Rays per side on pixels that straddle an edge (1 = one ray per pixel) [default: the
+    /// preset's: preview 2, default 4, final 8].
+    #[arg(long)]
+    pub supersample: Option<u32>,
     /// Meshless: shadow rays per area light traced at each camera hit for its direct light
-    /// (one per point light); 0 interpolates the direct light from the samples, as the paper.
-    #[arg(long, default_value_t = 16,
+    /// (one per point light); 0 interpolates the direct light from the samples, as the paper
+    /// [default: the preset's: preview 4, default 16, final 64].
+    #[arg(long,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
-    pub direct_rays: u32,
+    pub direct_rays: Option<u32>,
     /// Rays drawn from a glossy surface's lobe where a camera path meets one (and light samples
     /// per area light there).
     #[arg(long, default_value_t = 16,
@@ -191,7 +197,7 @@ pub struct SweepArgs {
     #[arg(long)]
     pub reference: PathBuf,
     /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
-    /// Keys: preset, epsilon, zeta, alpha, rounds, light-samples, tolerance, max-shots,
+    /// Keys: preset, epsilon, epsilon-scale, zeta, alpha, rounds, light-samples, tolerance, max-shots,
     /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
     /// supersample, direct-rays, specular-depth, specular-rays, glossy-rays, patch-size, spp.
     #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
@@ -199,14 +205,15 @@ pub struct SweepArgs {
     /// How each run computes its image.
     #[arg(long, default_value = "meshless")]
     pub method: Method,
-    /// Rays per side on edge pixels (meshless) or per pixel (patches).
-    #[arg(long, default_value_t = 4)]
-    pub supersample: u32,
+    /// Rays per side on edge pixels (meshless) or per pixel (patches) [default: the
+    /// preset's].
+    #[arg(long)]
+    pub supersample: Option<u32>,
     /// Meshless: shadow rays per area light traced at each camera hit for its direct light;
-    /// 0 interpolates it from the samples.
-    #[arg(long, default_value_t = 16,
+    /// 0 interpolates it from the samples [default: the preset's].
+    #[arg(long,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
-    pub direct_rays: u32,
+    pub direct_rays: Option<u32>,
     /// Patches: the side of the square patches (default: the solver's ε).
     #[arg(long)]
     pub patch_size: Option<f32>,
@@ -411,10 +418,27 @@ pub fn backend_from(args: &Knobs) -> meshlight::Backend {
         .unwrap_or_else(meshlight::Backend::default_backend)
 }
 
+/// The render's settings from a preset and the command line: `supersample` and `direct_rays`
+/// where given, the preset's otherwise.
+pub fn render_options_from(
+    args: &Knobs,
+    supersample: Option<u32>,
+    direct_rays: Option<u32>,
+) -> anyhow::Result<meshlight::RenderOptions> {
+    let mut o = args
+        .preset
+        .parse::<meshlight::solver::Preset>()?
+        .render_options();
+    o.supersample = supersample.unwrap_or(o.supersample).max(1);
+    o.direct = direct_rays.map_or(o.direct, meshlight::Direct::from_rays);
+    Ok(o)
+}
+
 /// Options from a preset and the command line's knobs.
 pub fn options_from(epsilon: Option<f32>, args: &Knobs) -> anyhow::Result<Options> {
     let mut o = args.preset.parse::<meshlight::solver::Preset>()?.options();
     o.epsilon = epsilon.or(o.epsilon);
+    o.epsilon_scale = args.epsilon_scale.unwrap_or(o.epsilon_scale);
     o.zeta = args.zeta.unwrap_or(o.zeta);
     o.alpha = args.alpha.unwrap_or(o.alpha);
     o.rounds = args.rounds.unwrap_or(o.rounds);

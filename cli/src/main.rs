@@ -189,10 +189,11 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         }
         Method::Meshless => {
             let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+            let preset = render_options_from(&r.solve.knobs, r.supersample, r.direct_rays)?;
             let render_options = meshlight::RenderOptions {
                 threads: options.threads,
-                supersample: r.supersample,
-                direct: meshlight::Direct::from_rays(r.direct_rays),
+                supersample: preset.supersample,
+                direct: preset.direct,
                 quantity: match r.false_color {
                     Some(FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
                     _ => meshlight::Quantity::Radiance,
@@ -256,7 +257,10 @@ fn patch_options(
             Some(h) => h,
             None => meshlight::solver::choose_epsilon(scene, options)?.0,
         },
-        supersample: r.supersample.max(1),
+        supersample: r
+            .supersample
+            .unwrap_or(meshlight::RenderOptions::default().supersample)
+            .max(1),
         tolerance: options.tolerance,
         max_shots: options.max_shots.unwrap_or(u64::MAX),
         seed: options.seed,

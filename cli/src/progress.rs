@@ -36,8 +36,16 @@ pub fn solve_with_progress(
     let (epsilon, source) = meshlight::solver::choose_epsilon(scene, options)?;
     if source == EpsilonSource::Automatic {
         eprintln!(
-            "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area (about {} initial samples)",
-            meshlight::solver::AUTO_SAMPLES
+            "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area (about {} initial samples{})",
+            meshlight::solver::AUTO_SAMPLES,
+            if options.epsilon_scale == 1.0 {
+                String::new()
+            } else {
+                format!(
+                    "; scaled by {} (--epsilon-scale or the preset)",
+                    options.epsilon_scale
+                )
+            }
         );
     }
     Ok(with_progress("solve", |progress| {

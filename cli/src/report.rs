@@ -312,9 +312,15 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         EpsilonSource::Automatic => "automatic",
         _ => "",
     };
+    let scaled = match s.epsilon_source() {
+        EpsilonSource::SceneFile | EpsilonSource::Automatic if o.epsilon_scale != 1.0 => {
+            format!(" × {}", o.epsilon_scale)
+        }
+        _ => String::new(),
+    };
     let _ = writeln!(
         out,
-        "scene {}: {} triangles, {} surfaces; backend {}, {} thread(s); ε {} ({source}), α {}, ζ {}, {} light samples",
+        "scene {}: {} triangles, {} surfaces; backend {}, {} thread(s); ε {} ({source}{scaled}), α {}, ζ {}, {} light samples",
         scene.path().display(),
         scene.triangles().len(),
         scene.surfaces().len(),

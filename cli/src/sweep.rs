@@ -21,6 +21,7 @@ use crate::Method;
 const KEYS: &[&str] = &[
     "preset",
     "epsilon",
+    "epsilon-scale",
     "zeta",
     "alpha",
     "rounds",
@@ -56,10 +57,11 @@ pub struct Sweep {
     pub epsilon: Option<f32>,
     /// The fixed knobs from the command line.
     pub knobs: super::Knobs,
-    /// Rays per side on edge pixels (meshless) or per pixel (patches).
-    pub supersample: u32,
-    /// Meshless: shadow rays per area light at each camera hit (0: interpolated direct light).
-    pub direct_rays: u32,
+    /// Rays per side on edge pixels (meshless) or per pixel (patches); `None`: the preset's.
+    pub supersample: Option<u32>,
+    /// Meshless: shadow rays per area light at each camera hit (0: interpolated direct light);
+    /// `None`: the preset's.
+    pub direct_rays: Option<u32>,
     /// Patch side (patches; default the solver's ε).
     pub patch_size: Option<f32>,
     /// Samples per pixel (pathtrace).
@@ -127,6 +129,7 @@ fn used_by(method: Method, key: &str) -> bool {
         Method::Patches => matches!(
             key,
             "epsilon"
+                | "epsilon-scale"
                 | "patch-size"
                 | "tolerance"
                 | "max-shots"
@@ -165,6 +168,7 @@ fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
     match key {
         "preset" => {}
         "epsilon" => o.epsilon = Some(value(key, v)?),
+        "epsilon-scale" => o.epsilon_scale = value(key, v)?,
         "zeta" => o.zeta = value(key, v)?,
         "alpha" => o.alpha = value(key, v)?,
         "rounds" => o.rounds = value(key, v)?,
@@ -258,9 +262,13 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             }
         }
         let mut options = super::options_from(sweep.epsilon, &knobs)?;
+        let render = super::render_options_from(&knobs, sweep.supersample, sweep.direct_rays)?;
         let mut extra = Extra {
-            supersample: sweep.supersample.max(1),
-            direct_rays: sweep.direct_rays,
+            supersample: render.supersample,
+            direct_rays: match render.direct {
+                meshlight::Direct::Interpolated => 0,
+                meshlight::Direct::Traced { light_samples } => light_samples,
+            },
             glossy_rays: meshlight::RenderOptions::default().glossy_rays,
             patch_size: sweep.patch_size,
             spp: sweep.spp,

@@ -887,3 +887,43 @@ fn the_report_opens_in_headless_chromium_and_prints_a_page_per_section() {
             .count();
     assert!(pages >= 5, "{pages} pages");
 }
+
+#[test]
+fn a_preset_sets_the_render_too_and_given_options_override_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("b.exr");
+    // The shadow rays the render traced, from its summary line.
+    let shadow_rays = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "scenes/box/scene.toml",
+            "-o",
+            exr.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = text(&succeed(&args).stdout);
+        let line = out
+            .lines()
+            .find(|l| l.starts_with("render "))
+            .unwrap()
+            .to_string();
+        let rays: u64 = line
+            .split(", ")
+            .find_map(|part| part.strip_suffix(" shadow rays"))
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("{line}"));
+        (rays, out)
+    };
+    let (preview, _) = shadow_rays(&["--preset", "preview"]);
+    let (default, _) = shadow_rays(&[]);
+    let (overridden, _) = shadow_rays(&["--preset", "preview", "--direct-rays", "16"]);
+    // 4 rays a hit instead of 16 (the penumbra's second look scales with them).
+    assert!(
+        4 * preview <= default + default / 10,
+        "{preview} vs {default}"
+    );
+    assert!(overridden > 3 * preview, "{overridden} vs {preview}");
+    // The final preset halves the scene file's ε (0.1 for the box) and says so.
+    let (_, out) = shadow_rays(&["--preset", "final", "--supersample", "1"]);
+    assert!(out.contains("ε 0.05 (scene file × 0.5)"), "{out}");
+}

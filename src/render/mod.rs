@@ -105,6 +105,37 @@ impl Default for RenderOptions {
     }
 }
 
+impl RenderOptions {
+    /// Fast and rough: fewer shadow rays at the hits and fewer rays on edges
+    /// ([`crate::Preset::Preview`]).
+    pub fn preview() -> Self {
+        RenderOptions {
+            supersample: PREVIEW_SUPERSAMPLE,
+            direct: Direct::Traced {
+                light_samples: PREVIEW_DIRECT_RAYS,
+            },
+            ..RenderOptions::default()
+        }
+    }
+
+    /// Slower and finer: more shadow rays at the hits and more rays on edges
+    /// ([`crate::Preset::Final`]).
+    pub fn final_quality() -> Self {
+        RenderOptions {
+            supersample: FINAL_SUPERSAMPLE,
+            direct: Direct::Traced {
+                light_samples: FINAL_DIRECT_RAYS,
+            },
+            ..RenderOptions::default()
+        }
+    }
+}
+
+const PREVIEW_SUPERSAMPLE: u32 = 2;
+const PREVIEW_DIRECT_RAYS: u32 = 4;
+const FINAL_SUPERSAMPLE: u32 = 8;
+const FINAL_DIRECT_RAYS: u32 = 64;
+
 /// What rendering did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[non_exhaustive]

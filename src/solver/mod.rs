@@ -265,17 +265,18 @@ impl Solution {
 pub fn choose_epsilon(scene: &Scene, options: &Options) -> Result<(f32, EpsilonSource)> {
     let (epsilon, source) = match (options.epsilon, scene.solver.epsilon) {
         (Some(e), _) => (e, EpsilonSource::Options),
-        (None, Some(e)) => (e, EpsilonSource::SceneFile),
+        (None, Some(e)) => (e * options.epsilon_scale, EpsilonSource::SceneFile),
         (None, None) => {
             let area = reflecting_area(scene);
             // Poisson-disk sets reach about 0.7 / ε² samples per unit area.
             let e = (0.7 * area / AUTO_SAMPLES).sqrt() as f32;
             (
-                if e > 0.0 {
-                    e
-                } else {
-                    scene.bounds.diagonal() / 50.0
-                },
+                options.epsilon_scale
+                    * if e > 0.0 {
+                        e
+                    } else {
+                        scene.bounds.diagonal() / 50.0
+                    },
                 EpsilonSource::Automatic,
             )
         }
@@ -477,6 +478,12 @@ pub const MAX_PIPELINE_CAPACITY: usize = 4096;
 
 fn check(options: &Options) -> Result<()> {
     let fail = |option, problem: String| Err(Error::Option { option, problem });
+    if !(options.epsilon_scale.is_finite() && (0.0625..=16.0).contains(&options.epsilon_scale)) {
+        return fail(
+            "epsilon_scale",
+            format!("{} must lie in [1/16, 16]", options.epsilon_scale),
+        );
+    }
     if !(options.alpha.is_finite() && options.alpha >= 0.0) {
         return fail(
             "alpha",

@@ -11,6 +11,10 @@ pub struct Options {
     /// [`AUTO_SAMPLES`] initial samples result. Halving ε quadruples the samples and multiplies
     /// the flat solver's time by about 16.
     pub epsilon: Option<f32>,
+    /// Multiplies the ε taken from the scene file or chosen automatically (not one set in
+    /// [`Options::epsilon`]), 1/16 to 16: presets use it to trade samples for time whatever
+    /// scale the scene was modelled at. Default 1.
+    pub epsilon_scale: f32,
     /// α, the fall-off of the area weights w(d) = exp(−α d) (eq. 5), useful 0–16: 0 splits a
     /// cell evenly among all samples within 2ε; large α gives each cell to its nearest sample.
     pub alpha: f32,
@@ -93,6 +97,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             epsilon: None,
+            epsilon_scale: 1.0,
             alpha: 8.0,
             zeta: 0.2,
             rounds: 2,
@@ -121,7 +126,11 @@ impl Options {
         self.cluster_threshold == 0.0
     }
 
-    /// Fast and rough: no adaptive rounds, few shadow rays, looser convergence.
+    /// Fast and rough: no adaptive rounds, few shadow rays, looser convergence (with
+    /// [`crate::RenderOptions::preview`]: few shadow rays and edge rays at the pixels). The
+    /// fastest setting measured within 2.5% MAE/mean of the path tracer on every shipped scene
+    /// (`docs/performance.md`, "Presets"); it keeps the scene's ε because the gallery is 3%
+    /// off at 1.2 ε, while simpler scenes allow [`Options::epsilon_scale`] 3 to 4.
     pub fn preview() -> Self {
         Options {
             rounds: 0,
@@ -131,11 +140,15 @@ impl Options {
         }
     }
 
-    /// Slower and finer: more rounds, a tighter ζ, more shadow rays, tighter convergence, and
-    /// a hierarchy five times tighter (on `cornell` at Kd 0.95: −0.08% against the path tracer
-    /// where the default gives −0.25%; docs/accuracy.md).
+    /// Slower and finer: samples half as far apart, more rounds, a tighter ζ, more shadow rays,
+    /// tighter convergence, and a hierarchy five times tighter (with
+    /// [`crate::RenderOptions::final_quality`]: more shadow and edge rays at the pixels). The
+    /// most accurate setting measured within 10 × the default's time on every shipped scene
+    /// (`docs/performance.md`, "Presets"). Four times the samples: a scene near the memory
+    /// budget at the defaults will not fit.
     pub fn final_quality() -> Self {
         Options {
+            epsilon_scale: 0.5,
             rounds: 3,
             zeta: 0.1,
             light_samples: 64,
@@ -176,6 +189,15 @@ impl Preset {
             Preset::Preview => Options::preview(),
             Preset::Default => Options::default(),
             Preset::Final => Options::final_quality(),
+        }
+    }
+
+    /// The preset's render settings.
+    pub fn render_options(self) -> crate::RenderOptions {
+        match self {
+            Preset::Preview => crate::RenderOptions::preview(),
+            Preset::Default => crate::RenderOptions::default(),
+            Preset::Final => crate::RenderOptions::final_quality(),
         }
     }
 }
