@@ -5,7 +5,9 @@
 
 mod common;
 
-use common::{assert_dark_room_is_dark, backends, shipped, solve, solve_and_render, two_rooms};
+use common::{
+    assert_dark_room_is_dark, backends, shipped, shipped_at, solve, solve_and_render, two_rooms,
+};
 use meshlight::solver::{Control, Options, StopReason};
 use meshlight::{Backend, Scene};
 
@@ -297,6 +299,34 @@ fn at_albedo_0_95_the_hierarchy_delivers_what_its_shooters_send() {
             "{backend}: {:.3}% of the emitted power leaves the hierarchy's surfaces, {:.3}% the flat solver's",
             100.0 * tree,
             100.0 * flat
+        );
+    }
+}
+
+#[test]
+fn after_adaptive_rounds_the_hierarchy_matches_the_flat_solver_block_by_block() {
+    // The shipped room at the defaults (two adaptive rounds), 128²: over 4 × 4 blocks the
+    // hierarchy's image against the flat solver's, the independent O(N²) transport. The tail
+    // extrapolated after a warm start left a blotch by the front box's foot: p99 2.59% (0.44%
+    // since it is taken only for unshot power of one sign).
+    let scene = shipped_at("room", 128);
+    for backend in backends() {
+        let (_, hierarchy) = solve_and_render(&scene, backend, Options::default(), true);
+        let flat = Options {
+            cluster_threshold: 0.0,
+            ..Options::default()
+        };
+        let (_, flat) = solve_and_render(&scene, backend, flat, true);
+        let e = meshlight::metrics::compare_blocks(&hierarchy, &flat, 4).unwrap();
+        eprintln!(
+            "{backend}: hierarchy vs flat over 4 x 4 blocks: MAE/mean {:.3}%, p99 {:.3}%",
+            100.0 * e.mae_over_mean,
+            100.0 * e.p99_over_mean
+        );
+        assert!(
+            e.p99_over_mean < 0.01,
+            "{backend}: p99 {:.3}%",
+            100.0 * e.p99_over_mean
         );
     }
 }

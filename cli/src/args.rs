@@ -45,7 +45,7 @@ pub struct Knobs {
     #[arg(long, default_value = "default")]
     pub preset: String,
     /// Multiplies the ε from the scene file or the automatic choice (not `--epsilon`), 1/16 to
-    /// 16 [default: the preset's: 1, final 0.5].
+    /// 16 [default: the preset's: 1, final 0.6].
     #[arg(long)]
     pub epsilon_scale: Option<f32>,
     /// Adaptive error threshold ζ, relative to the mean radiosity.

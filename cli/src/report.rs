@@ -326,7 +326,10 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         scene.surfaces().len(),
         backend,
         o.threads,
-        s.epsilon(),
+        // Six significant figures: a scaled ε (0.1 × 0.6) prints as 0.06, not 0.060000002.
+        format!("{:.6}", s.epsilon())
+            .trim_end_matches('0')
+            .trim_end_matches('.'),
         o.alpha,
         o.zeta,
         o.light_samples

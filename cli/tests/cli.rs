@@ -923,7 +923,7 @@ fn a_preset_sets_the_render_too_and_given_options_override_it() {
         "{preview} vs {default}"
     );
     assert!(overridden > 3 * preview, "{overridden} vs {preview}");
-    // The final preset halves the scene file's ε (0.1 for the box) and says so.
+    // The final preset takes 0.6 of the scene file's ε (0.1 for the box) and says so.
     let (_, out) = shadow_rays(&["--preset", "final", "--supersample", "1"]);
-    assert!(out.contains("ε 0.05 (scene file × 0.5)"), "{out}");
+    assert!(out.contains("ε 0.06 (scene file × 0.6)"), "{out}");
 }

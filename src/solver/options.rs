@@ -140,15 +140,15 @@ impl Options {
         }
     }
 
-    /// Slower and finer: samples half as far apart, more rounds, a tighter ζ, more shadow rays,
+    /// Slower and finer: samples at 0.6 of the scene's spacing, more rounds, a tighter ζ, more shadow rays,
     /// tighter convergence, and a hierarchy five times tighter (with
     /// [`crate::RenderOptions::final_quality`]: more shadow and edge rays at the pixels). The
     /// most accurate setting measured within 10 × the default's time on every shipped scene
-    /// (`docs/performance.md`, "Presets"). Four times the samples: a scene near the memory
-    /// budget at the defaults will not fit.
+    /// (`docs/performance.md`, "Presets"). About three times the samples: a scene near the
+    /// memory budget at the defaults will not fit.
     pub fn final_quality() -> Self {
         Options {
-            epsilon_scale: 0.5,
+            epsilon_scale: 0.6,
             rounds: 3,
             zeta: 0.1,
             light_samples: 64,

@@ -41,6 +41,16 @@ pub fn shipped(name: &str) -> PathBuf {
         .join("scene.toml")
 }
 
+/// A shipped scene with its camera's image resized to `size` × `size` (references traced in
+/// tests stay affordable).
+pub fn shipped_at(name: &str, size: u32) -> Scene {
+    let mut scene = Scene::load(shipped(name)).unwrap();
+    let mut camera = *scene.camera();
+    (camera.width, camera.height) = (size, size);
+    scene.set_camera(camera).unwrap();
+    scene
+}
+
 /// A diffuse material.
 pub fn material(name: &str, kd: f32, ke: f32) -> Material {
     Material::diffuse(name, Vec3::splat(kd), Vec3::splat(ke))
