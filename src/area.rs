@@ -15,7 +15,9 @@ use glam::{DVec3, Vec2};
 
 use crate::error::Result;
 use crate::parallel::{for_chunks, for_chunks_reporting, Report};
-use crate::sampling::{surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap};
+use crate::sampling::{
+    surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap, CELL_UNITS,
+};
 use crate::visibility::Visibility;
 
 /// What the area computation did.
@@ -73,42 +75,52 @@ pub(crate) fn compute(
         stats.queries += chunk.queries;
         stats.orphan_cells += chunk.orphans;
     }
-    gather_shares(samples, &layout, chunks, &redo);
+    gather_shares(samples, maps, layout, chunks, &redo);
     region_centroids(samples, threads)?;
     Ok(stats)
 }
 
-/// The range of `samples.cells` each side holds from the last computation (cells are stored
-/// side by side).
+/// The range of `samples.cells` each side holds from the last computation.
 fn previous_cells(samples: &Samples, sides: usize) -> Vec<std::ops::Range<usize>> {
-    let mut kept = vec![0..0; sides];
-    let mut at = 0;
-    while at < samples.cells.len() {
-        let side = samples.cells[at].side as usize;
-        let end = at
-            + samples.cells[at..]
-                .iter()
-                .take_while(|c| c.side as usize == side)
-                .count();
-        if side < sides {
-            kept[side] = at..end;
-        }
-        at = end;
-    }
-    kept
+    (0..sides)
+        .map(|side| samples.cells_of(side as u32))
+        .collect()
 }
 
 /// The cells of one computation, side by side: kept cells where a side did not change (each
 /// with its old index), new ones (to split among samples) elsewhere.
 struct Layout {
-    /// Per cell: (side, area, 2D centroid); kept cells carry no area here (their shares are kept).
-    cells: Vec<(u32, f64, Vec2)>,
-    /// Per cell: its index in the last computation, if kept.
-    old: Vec<Option<u32>>,
-    /// Per cell: the cell as the samples store it.
-    stored: Vec<AreaCell>,
+    cells: Vec<Laid>,
+    /// Per side: where its cells start in `cells` (length sides + 1).
+    start: Vec<u32>,
+    /// Per side: half the width of its new cells.
+    half: Vec<f32>,
     /// Per old cell: its new index (`u32::MAX` if dropped).
     moved: Vec<u32>,
+}
+
+/// A cell of the layout (16 bytes: a round lays out some 16 a sample).
+#[derive(Clone, Copy)]
+struct Laid {
+    /// Its index in the last computation if kept (its shares are kept too), else `u32::MAX`.
+    old: u32,
+    /// Area (0 for a kept cell).
+    area: f32,
+    /// Centroid, 2D (on its side's surface).
+    centroid: Vec2,
+}
+
+impl Laid {
+    fn is_new(&self) -> bool {
+        self.old == u32::MAX
+    }
+}
+
+impl Layout {
+    /// The side cell `c` lies on.
+    fn side_of(&self, c: usize) -> u32 {
+        (self.start.partition_point(|&s| s as usize <= c) as u32).saturating_sub(1)
+    }
 }
 
 /// Cuts every changed side into cells (clipped side by side in parallel) and lists them with
@@ -143,42 +155,66 @@ fn lay_cells(
         clip_cells(map, cell, &mut out[0].1);
         Ok(())
     })?;
+    // Memory: every side's list is freed as soon as it is laid out, and the layout is
+    // reserved exactly (the cells are this phase's largest arrays after the shares).
+    let total: usize = active
+        .iter()
+        .zip(&clipped)
+        .map(|(&side, c)| {
+            if redo(side) {
+                c.1.len()
+            } else {
+                kept[side].len()
+            }
+        })
+        .sum();
     let mut layout = Layout {
-        cells: Vec::new(),
-        old: Vec::new(),
-        stored: Vec::new(),
+        cells: Vec::with_capacity(total),
+        start: vec![0; sides + 1],
+        half: vec![0.0; sides],
         moved: vec![u32::MAX; samples.cells.len()],
     };
-    for (&side, (cell, list)) in active.iter().zip(&clipped) {
+    let mut at = 0;
+    for (&side, (cell, list)) in active.iter().zip(clipped) {
+        // Sides without cells start where the next one does.
+        for s in &mut layout.start[at..=side] {
+            *s = layout.cells.len() as u32;
+        }
+        at = side + 1;
         if !redo(side) {
             for i in kept[side].clone() {
                 layout.moved[i] = layout.cells.len() as u32;
-                layout.stored.push(samples.cells[i]);
-                layout.cells.push((side as u32, 0.0, Vec2::ZERO));
-                layout.old.push(Some(i as u32));
+                layout.cells.push(Laid {
+                    old: i as u32,
+                    area: 0.0,
+                    centroid: Vec2::ZERO,
+                });
             }
             continue;
         }
-        let map = &maps[surface_of(side as u32) as usize];
-        for &(_, a, centroid) in list {
-            layout.cells.push((side as u32, a, centroid));
-            layout.old.push(None);
-            layout.stored.push(AreaCell {
-                centroid: map.to_3d(centroid),
-                area: a as f32,
-                half: 0.5 * cell,
-                side: side as u32,
-            });
-        }
+        layout.half[side] = 0.5 * cell;
+        layout
+            .cells
+            .extend(list.into_iter().map(|(_, area, centroid)| Laid {
+                old: u32::MAX,
+                area: area as f32,
+                centroid,
+            }));
+    }
+    for s in &mut layout.start[at..] {
+        *s = layout.cells.len() as u32;
     }
     Ok(layout)
 }
 
 /// Gathers the shares by sample, in cell order within each sample (a counting sort): a sample
 /// on a kept side keeps its shares (their cells renumbered), the others take the new ones.
+/// Each input is freed as soon as it has been read, so the old and new arrays are not all
+/// held at once.
 fn gather_shares(
     samples: &mut Samples,
-    layout: &Layout,
+    maps: &[SurfaceMap],
+    layout: Layout,
     chunks: Vec<CellShares>,
     redo: &dyn Fn(usize) -> bool,
 ) {
@@ -188,41 +224,82 @@ fn gather_shares(
     let mut start = vec![0u32; n + 1];
     for k in 0..n {
         if kept_sample(k) {
-            start[k + 1] = samples.shares_of(k).len() as u32;
+            start[k + 1] = samples.share_range(k).len() as u32;
         }
     }
     for chunk in &chunks {
-        for &(_, k, _) in &chunk.shares {
+        for &k in &chunk.samples {
             start[k as usize + 1] += 1;
         }
     }
     for k in 0..n {
         start[k + 1] += start[k];
     }
-    let mut shares = vec![(0u32, 0.0f32); start[n] as usize];
+    let mut shares = vec![0u32; start[n] as usize];
+    let mut units = vec![0u16; start[n] as usize];
     let mut area = vec![0.0f64; n];
     let mut next = start.clone();
     for k in 0..n {
         if kept_sample(k) {
-            for &(c, a) in samples.shares_of(k) {
-                area[k] += f64::from(a);
-                shares[next[k] as usize] = (layout.moved[c as usize], a);
+            area[k] = samples.shares_of(k).map(|(_, a)| f64::from(a)).sum();
+            for i in samples.share_range(k) {
+                let at = next[k] as usize;
+                shares[at] = layout.moved[samples.shares[i] as usize];
+                units[at] = samples.share_units[i];
                 next[k] += 1;
             }
         }
     }
+    samples.shares = Vec::new();
+    samples.share_units = Vec::new();
+    let mut cell = 0usize;
     for chunk in chunks {
-        for (id, k, share) in chunk.shares {
-            let k = k as usize;
-            area[k] += share;
-            shares[next[k] as usize] = (id, share as f32);
-            next[k] += 1;
+        let mut run = chunk.samples.iter().zip(&chunk.units);
+        for &count in &chunk.counts {
+            let unit = f64::from(layout.cells[cell].area) / f64::from(CELL_UNITS);
+            for (&k, &u) in run.by_ref().take(count as usize) {
+                let k = k as usize;
+                area[k] += f64::from(u) * unit;
+                let at = next[k] as usize;
+                shares[at] = cell as u32;
+                units[at] = u;
+                next[k] += 1;
+            }
+            cell += 1;
         }
     }
     samples.share_start = start;
     samples.shares = shares;
-    samples.cells = layout.stored.clone();
+    samples.share_units = units;
     samples.area = area;
+    let old = std::mem::take(&mut samples.cells);
+    let cell_start = layout.start;
+    // A kept side keeps its cells' width; a side without cells has none.
+    let mut cell_half = layout.half;
+    for (side, half) in cell_half.iter_mut().enumerate() {
+        if cell_start[side] == cell_start[side + 1] {
+            *half = 0.0;
+        } else if !redo(side) {
+            *half = samples.cell_half.get(side).copied().unwrap_or(0.0);
+        }
+    }
+    let mut cells = Vec::with_capacity(layout.cells.len());
+    for (side, w) in cell_start.windows(2).enumerate() {
+        let map = &maps[surface_of(side as u32) as usize];
+        cells.extend(layout.cells[w[0] as usize..w[1] as usize].iter().map(|c| {
+            if c.is_new() {
+                AreaCell {
+                    centroid: map.to_3d(c.centroid),
+                    area: c.area,
+                }
+            } else {
+                old[c.old as usize]
+            }
+        }));
+    }
+    samples.cells = cells;
+    samples.cell_start = cell_start;
+    samples.cell_half = cell_half;
 }
 
 /// Each sample's region centroid: the area-weighted centre of its shares (its position if it
@@ -234,7 +311,7 @@ fn region_centroids(samples: &mut Samples, threads: usize) -> Result<()> {
         for (c, k) in chunk.iter_mut().zip(first..) {
             let mut mass = 0.0f64;
             let mut sum = DVec3::ZERO;
-            for &(cell, a) in shared.shares_of(k) {
+            for (cell, a) in shared.shares_of(k) {
                 mass += f64::from(a);
                 sum += f64::from(a) * shared.cells[cell as usize].centroid.as_dvec3();
             }
@@ -250,15 +327,30 @@ fn region_centroids(samples: &mut Samples, threads: usize) -> Result<()> {
     Ok(())
 }
 
-/// The shares of a run of cells: (cell, sample, area) in cell order.
+/// The shares of a run of cells, in cell order: how many each cell of the run has (none for a
+/// kept cell), and the sample and units (of [`CELL_UNITS`]) of each share.
 #[derive(Clone, Debug, Default)]
 struct CellShares {
     /// Whether the run was split (a stopped computation leaves later runs undone).
     done: bool,
-    shares: Vec<(u32, u32, f64)>,
+    counts: Vec<u32>,
+    samples: Vec<u32>,
+    units: Vec<u16>,
     /// Cells with no visible sample within R, given to the nearest one.
     orphans: usize,
     queries: u64,
+}
+
+impl CellShares {
+    fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// A whole cell to sample k.
+    fn whole(&mut self, k: u32) {
+        self.samples.push(k);
+        self.units.push(CELL_UNITS as u16);
+    }
 }
 
 /// What splitting a cell among samples reads.
@@ -282,24 +374,39 @@ impl Shares<'_> {
         let cells = &layout.cells;
         let mut chunks: Vec<CellShares> = vec![CellShares::default(); cells.len().div_ceil(CHUNK)];
         let split = |c: usize, out: &mut [CellShares]| {
-            let mut near = Vec::new();
-            out[0].done = true;
+            let (mut near, mut units) = (Vec::new(), Vec::new());
+            let out = &mut out[0];
+            out.done = true;
             let ids = c * CHUNK..((c + 1) * CHUNK).min(cells.len());
-            for (id, &(side, a, centroid)) in ids.clone().zip(&cells[ids]) {
-                if layout.old[id].is_none() {
+            out.counts.reserve_exact(ids.len());
+            for (cell, id) in cells[ids.clone()].iter().zip(ids) {
+                let before = out.len();
+                if cell.is_new() {
+                    let side = layout.side_of(id);
                     let map = &self.maps[surface_of(side) as usize];
-                    self.of_cell(id as u32, side, map, a, centroid, &mut near, &mut out[0])?;
+                    self.of_cell(side, cell, map, (&mut near, &mut units), out)?;
                 }
+                out.counts.push((out.len() - before) as u32);
             }
+            out.samples.shrink_to_fit();
+            out.units.shrink_to_fit();
             Ok(())
         };
         if !for_chunks_reporting(&mut chunks, 1, threads, split, report)? {
             for (c, chunk) in chunks.iter_mut().enumerate().filter(|(_, c)| !c.done) {
                 let ids = c * CHUNK..((c + 1) * CHUNK).min(cells.len());
-                for (id, &(side, a, centroid)) in ids.clone().zip(&cells[ids]) {
-                    let nearest = self.index.nearest(self.samples, side, centroid);
-                    if let (None, Some(k)) = (layout.old[id], nearest) {
-                        chunk.shares.push((id as u32, k, a));
+                chunk.counts.clear();
+                chunk.samples.clear();
+                chunk.units.clear();
+                for (cell, id) in cells[ids.clone()].iter().zip(ids) {
+                    let side = layout.side_of(id);
+                    let nearest = self.index.nearest(self.samples, side, cell.centroid);
+                    match nearest.filter(|_| cell.is_new()) {
+                        Some(k) => {
+                            chunk.whole(k);
+                            chunk.counts.push(1);
+                        }
+                        None => chunk.counts.push(0),
                     }
                 }
             }
@@ -307,20 +414,17 @@ impl Shares<'_> {
         Ok(chunks)
     }
 
-    /// Splits cell `id` of area `a` at `centroid` (2D, on `side`) among the samples of the
-    /// side within R of it (eq. 5), into `out`.
-    #[allow(clippy::too_many_arguments)]
+    /// Splits a new cell among the samples of its side within R of it (eq. 5), into `out`.
     fn of_cell(
         &self,
-        id: u32,
         side: u32,
+        cell: &Laid,
         map: &SurfaceMap,
-        a: f64,
-        centroid: Vec2,
-        near: &mut Vec<(u32, f32)>,
+        (near, units): (&mut Vec<(u32, f32)>, &mut Vec<u16>),
         out: &mut CellShares,
     ) -> Result<()> {
         let (samples, index) = (self.samples, self.index);
+        let centroid = cell.centroid;
         let Some(nearest) = index.nearest(samples, side, centroid) else {
             return Ok(());
         };
@@ -340,16 +444,45 @@ impl Shares<'_> {
                 .obstruction
                 .retain_visible(self.vis, self.maps, samples, side, point, near)?;
             let k = near.first().map_or(nearest, |n| n.0);
-            out.shares.push((id, k, a));
+            out.whole(k);
             return Ok(());
         }
         // Ascending sample order: the sum does not depend on the grid's iteration order.
         near.sort_unstable_by_key(|&(k, _)| k);
         let weight = |d2: f32| f64::from((-self.alpha * d2.sqrt() / r).exp());
         let total: f64 = near.iter().map(|&(_, d2)| weight(d2)).sum();
-        out.shares
-            .extend(near.iter().map(|&(k, d2)| (id, k, a * weight(d2) / total)));
+        let parts = near.iter().map(|&(_, d2)| weight(d2) / total);
+        split_units(parts, units);
+        for (&(k, _), &u) in near.iter().zip(units.iter()) {
+            if u > 0 {
+                out.samples.push(k);
+                out.units.push(u);
+            }
+        }
         Ok(())
+    }
+}
+
+/// Splits a cell's [`CELL_UNITS`] among parts (fractions adding up to 1) by largest
+/// remainders, so that the units add up to the whole cell exactly; ties go to the earlier part.
+fn split_units(parts: impl Iterator<Item = f64>, units: &mut Vec<u16>) {
+    let whole = f64::from(CELL_UNITS);
+    let mut rest: Vec<(f64, usize)> = Vec::new();
+    units.clear();
+    let mut given = 0u32;
+    for (i, p) in parts.enumerate() {
+        let exact = (p * whole).clamp(0.0, whole);
+        let u = exact.floor();
+        units.push(u as u16);
+        given += u as u32;
+        rest.push((exact - u, i));
+    }
+    let short = CELL_UNITS.saturating_sub(given) as usize;
+    if short > 0 {
+        rest.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        for &(_, i) in rest.iter().cycle().take(short) {
+            units[i] = units[i].saturating_add(1);
+        }
     }
 }
 
@@ -461,6 +594,26 @@ fn area_centroid(poly: &[Vec2]) -> Option<(f64, Vec2)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cell_is_split_into_units_that_add_up_to_it() {
+        // By hand: 65535 x (1/2, 1/4, 1/4) = 32767.5, 16383.75, 16383.75; the floors leave 2
+        // units, which go to the two largest remainders (0.75 each).
+        let mut units = Vec::new();
+        split_units([0.5, 0.25, 0.25].into_iter(), &mut units);
+        assert_eq!(units, [32767, 16384, 16384]);
+        // Any split: the whole cell, each part within one unit of its exact share.
+        let parts: Vec<f64> = (1..=13).map(|i| f64::from(i * i)).collect();
+        let total: f64 = parts.iter().sum();
+        split_units(parts.iter().map(|p| p / total), &mut units);
+        assert_eq!(units.iter().map(|&u| u32::from(u)).sum::<u32>(), CELL_UNITS);
+        for (p, &u) in parts.iter().zip(&units) {
+            assert!((p / total * f64::from(CELL_UNITS) - f64::from(u)).abs() < 1.0);
+        }
+        // One part takes it all.
+        split_units([1.0].into_iter(), &mut units);
+        assert_eq!(units, [u16::MAX]);
+    }
 
     #[test]
     fn clipping_a_triangle_into_cells_keeps_its_area() {

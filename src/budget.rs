@@ -10,9 +10,47 @@
 pub const DEFAULT_MEMORY_BUDGET: usize = 8 << 30;
 
 /// Bytes a sample is budgeted at before it is placed: its arrays, area cells and shares,
-/// index entries and results. `Solution::bytes` / samples measured 1,420–1,950 on the shipped
-/// scenes at the defaults (vectors grown by doubling hold up to twice what they use).
+/// index entries and results, and the moment's second copy of its shares while a round splits
+/// the cells. `Solution::bytes` / samples measured 1,188 on the shipped room at the defaults
+/// (`tests/breakdown.rs`).
 pub const BYTES_PER_SAMPLE: usize = 3072;
+
+/// What a solution holds, by part, in bytes (vectors' capacities): where the memory per sample
+/// goes (`meshlight scale` prints it). The links and the tree live only while a round shoots;
+/// their bytes are in [`ShootStats::bytes`](crate::solver::ShootStats::bytes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct Breakdown {
+    /// The samples' own arrays: positions, normals, 2D positions, sides, radii, areas,
+    /// centroids, rounds, reflectances.
+    pub samples: usize,
+    /// The area cells.
+    pub cells: usize,
+    /// The samples' shares of the cells, and where each sample's start.
+    pub shares: usize,
+    /// The per-side index for range queries.
+    pub index: usize,
+    /// Per-sample results: radiosity, irradiance, unshot radiosity, direct light, flags and
+    /// row scales.
+    pub results: usize,
+    /// Light by way of specular surfaces.
+    pub specular: usize,
+    /// The surfaces' 2D triangles.
+    pub maps: usize,
+}
+
+impl Breakdown {
+    /// All of it.
+    pub fn total(&self) -> usize {
+        self.samples
+            + self.cells
+            + self.shares
+            + self.index
+            + self.results
+            + self.specular
+            + self.maps
+    }
+}
 
 /// Bytes in binary units, for messages: "3.2 GiB".
 pub fn human_bytes(bytes: f64) -> String {

@@ -353,7 +353,7 @@ pub enum Command {
         #[arg(long, value_delimiter = ',', required = true)]
         epsilon: Vec<f32>,
         /// Skip a flat solve predicted (from the previous one, as N²) to take longer than this
-        /// many seconds.
+        /// many seconds; 0 skips the flat solver altogether.
         #[arg(long, default_value_t = 600.0)]
         flat_limit: f64,
         #[command(flatten)]

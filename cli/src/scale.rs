@@ -19,6 +19,10 @@ struct Run {
     /// Place, areas, direct, links, shooting, and the whole solve.
     seconds: [f64; 6],
     peak: Option<u64>,
+    /// What the solution holds at the end, by part.
+    held: meshlight::budget::Breakdown,
+    /// The links, tree and caches of the largest round.
+    links_bytes: u64,
 }
 
 /// Solves the scene at every ε with the hierarchy (and the flat solver while it is predicted
@@ -64,7 +68,12 @@ pub fn run(
     // The hierarchy's solves first, then the flat solver's, each from the largest ε: memory a
     // solve freed may stay with the process, and only a larger solve after it measures its own
     // peak.
-    for flat in [false, true] {
+    let solvers: &[bool] = if flat_limit > 0.0 {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    for &flat in solvers {
         for (i, &epsilon) in epsilons.iter().enumerate() {
             if flat {
                 // The hierarchy's solve at this ε says how many samples the flat one will have.
@@ -99,6 +108,7 @@ pub fn run(
                 reset.then(memory::peak_bytes).flatten(),
             );
             println!("{}", row(&run));
+            println!("{}", per_sample(&run));
             if flat {
                 last_flat = Some((run.samples, total));
             }
@@ -129,7 +139,42 @@ fn measure(flat: bool, epsilon: f32, s: &Solution, total: f64, peak: Option<u64>
         queries: s.rounds().iter().map(|r| r.shooting.queries).sum(),
         seconds,
         peak,
+        held: s.memory(),
+        links_bytes: s
+            .rounds()
+            .iter()
+            .map(|r| r.shooting.bytes)
+            .max()
+            .unwrap_or(0),
     }
+}
+
+/// Where the memory goes, per sample: what the solution holds by part, the links of its largest
+/// round, and the process's peak.
+fn per_sample(r: &Run) -> String {
+    let n = r.samples.max(1) as f64;
+    let h = &r.held;
+    let mut s = String::from("       bytes per sample:");
+    for (name, bytes) in [
+        ("samples", h.samples),
+        ("cells", h.cells),
+        ("shares", h.shares),
+        ("index", h.index),
+        ("results", h.results),
+        ("specular", h.specular),
+        ("maps", h.maps),
+        ("links+tree", r.links_bytes as usize),
+    ] {
+        let _ = write!(s, " {name} {:.0},", bytes as f64 / n);
+    }
+    let _ = write!(
+        s,
+        " held {:.0}; peak {}",
+        (h.total() as f64 + r.links_bytes as f64) / n,
+        r.peak
+            .map_or("-".into(), |b| format!("{:.0}", b as f64 / n))
+    );
+    s
 }
 
 fn row(r: &Run) -> String {
@@ -182,6 +227,9 @@ fn exponents(runs: &[Run]) -> String {
                 .map(|r| (r.samples as f64, f(r)))
                 .collect()
         };
+        if !runs.iter().any(|r| r.flat == flat) {
+            continue;
+        }
         let show = |x: Option<f64>| x.map_or("-".to_string(), |e| format!("N^{e:.2}"));
         let _ = writeln!(
             out,

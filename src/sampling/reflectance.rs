@@ -25,8 +25,8 @@ pub(crate) fn means(
     }
     let mut cells = vec![Vec3::ZERO; samples.cells.len()];
     for_chunks(&mut cells, 1024, threads, |first, chunk| {
-        for (out, cell) in chunk.iter_mut().zip(&samples.cells[first..]) {
-            *out = cell_mean(scene, maps, cell);
+        for ((out, cell), c) in chunk.iter_mut().zip(&samples.cells[first..]).zip(first..) {
+            *out = cell_mean(scene, maps, cell, samples.side_of_cell(c));
         }
         Ok(())
     })?;
@@ -36,7 +36,7 @@ pub(crate) fn means(
             let surface = surface_of(samples.side[k]);
             let (mut area, mut sum) = (0.0f32, Vec3::ZERO);
             if scene.is_textured(surface) {
-                for &(c, a) in samples.shares_of(k) {
+                for (c, a) in samples.shares_of(k) {
                     area += a;
                     sum += a * cells[c as usize];
                 }
@@ -56,8 +56,8 @@ pub(crate) fn means(
 }
 
 /// A cell's mean reflectance (zero on untextured surfaces: nothing asks for it).
-fn cell_mean(scene: &Scene, maps: &[SurfaceMap], cell: &AreaCell) -> Vec3 {
-    let surface = surface_of(cell.side);
+fn cell_mean(scene: &Scene, maps: &[SurfaceMap], cell: &AreaCell, side: u32) -> Vec3 {
+    let surface = surface_of(side);
     if !scene.is_textured(surface) {
         return Vec3::ZERO;
     }

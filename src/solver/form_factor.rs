@@ -78,8 +78,15 @@ pub(crate) fn segment(samples: &Samples, lift: f32, j: usize, i: usize) -> Segme
 /// the area cells (the shares of all samples tile the surfaces): exact (Lambert's formula on
 /// the cell's square) for cells within two cell widths, point to point beyond.
 fn near_factor(samples: &Samples, shooter: &Shooter, x: Vec3, n: Vec3) -> f32 {
+    let k = shooter.index as usize;
+    let half = samples
+        .side
+        .get(k)
+        .and_then(|&side| samples.cell_half.get(side as usize))
+        .copied()
+        .unwrap_or(0.0);
     let mut sum = 0.0f64;
-    for &(c, share) in samples.shares_of(shooter.index as usize) {
+    for (c, share) in samples.shares_of(k) {
         let cell = &samples.cells[c as usize];
         let d = x - cell.centroid;
         let r2 = d.length_squared();
@@ -88,7 +95,7 @@ fn near_factor(samples: &Samples, shooter: &Shooter, x: Vec3, n: Vec3) -> f32 {
             continue;
         }
         let fraction = f64::from(share / cell.area);
-        if r2 < 16.0 * cell.half * cell.half {
+        if r2 < 16.0 * half * half {
             let h = 0.5 * cell.area.sqrt();
             let (u, v) = (shooter.u * h, shooter.v * h);
             let c = cell.centroid;

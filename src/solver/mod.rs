@@ -140,22 +140,28 @@ impl Solution {
     /// Bytes the solution holds: samples, their index, and per-sample results (the part of
     /// the memory budget that grows with the samples).
     pub fn bytes(&self) -> usize {
+        self.memory().total()
+    }
+
+    /// The bytes the solution holds, by part.
+    pub fn memory(&self) -> crate::budget::Breakdown {
         use crate::sampling::vec_bytes;
-        self.samples.bytes()
-            + self.index.bytes()
-            + vec_bytes(&self.radiosity)
-            + vec_bytes(&self.irradiance)
-            + vec_bytes(&self.unshot)
-            + vec_bytes(&self.direct)
-            + vec_bytes(&self.closed)
-            + vec_bytes(&self.covered)
-            + vec_bytes(&self.row_scale)
-            + self.specular.as_ref().map_or(0, specular::Transfer::bytes)
-            + self
-                .maps
-                .iter()
-                .map(|m| vec_bytes(&m.triangles))
-                .sum::<usize>()
+        let (samples, cells, shares) = self.samples.bytes();
+        crate::budget::Breakdown {
+            samples,
+            cells,
+            shares,
+            index: self.index.bytes(),
+            results: vec_bytes(&self.radiosity)
+                + vec_bytes(&self.irradiance)
+                + vec_bytes(&self.unshot)
+                + vec_bytes(&self.direct)
+                + vec_bytes(&self.closed)
+                + vec_bytes(&self.covered)
+                + vec_bytes(&self.row_scale),
+            specular: self.specular.as_ref().map_or(0, specular::Transfer::bytes),
+            maps: self.maps.iter().map(|m| vec_bytes(&m.triangles)).sum(),
+        }
     }
 
     /// Checks the samples' invariants (see the crate's docs: Poisson-disk spacing, areas that
@@ -652,7 +658,11 @@ mod tests {
             .contains("is not its shares'"));
         // Shares that do not tile the cells.
         let mut broken = s.clone();
-        broken.samples.shares[0].1 *= 2.0;
+        // (The largest share, so that the cell's sum moves by more than the tolerance.)
+        let largest = (0..broken.samples.share_units.len())
+            .max_by_key(|&i| broken.samples.share_units[i])
+            .unwrap();
+        broken.samples.share_units[largest] /= 2;
         let e = broken.validate().unwrap_err();
         assert!(
             e.contains("is not its shares'") || e.contains("shared out"),

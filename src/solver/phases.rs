@@ -99,6 +99,7 @@ impl Solve<'_> {
                 samples.push(maps, side, p, epsilon, 0);
             }
         }
+        samples.shrink_to_fit();
         Ok(samples)
     }
 
@@ -231,6 +232,7 @@ impl Solve<'_> {
             let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
             (arrivals, queries, covered)
         };
+        solution.covered.reserve_exact(covered.len());
         solution.covered.extend(covered);
         let mut queries = queries;
         if let (Some(transfer), Some((spec, lights))) = (
@@ -298,7 +300,9 @@ impl Solve<'_> {
                 &mut self.reporter.part(base),
             )?
         };
+        solution.closed.reserve_exact(probes.len());
         solution.closed.extend(probes);
+        solution.row_scale.reserve_exact(n - first_new);
         let hierarchical = self.grid.is_some();
         for k in first_new..n {
             // The flat solver sums rows in its first round only: later samples take the scale
@@ -462,6 +466,7 @@ impl Solve<'_> {
         // A Stop heard while the errors were measured added nothing; one heard at their last
         // report may have, and the round that follows then keeps the arrays whole (its
         // phases are skipped).
+        solution.samples.shrink_to_fit();
         let samples = &solution.samples;
         let mut changed = vec![false; 2 * solution.maps.len()];
         for k in 0..samples.len() {

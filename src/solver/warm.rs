@@ -107,6 +107,11 @@ pub(crate) fn start(
         }
         Ok(())
     })?;
+    // Exactly: a round's new samples would leave up to as many slots unused.
+    solution.direct.reserve_exact(arrivals.len());
+    solution.irradiance.reserve_exact(out.len());
+    solution.unshot.reserve_exact(out.len());
+    solution.radiosity.reserve_exact(out.len());
     solution.direct.extend_from_slice(arrivals);
     for (h, unshot, radiosity) in out {
         solution.irradiance.push(h);
