@@ -11,10 +11,14 @@
 //! denser samples instead of hundreds of samples within 2ε (which would smear areas and cost
 //! O(samples²) per cell).
 
+mod split;
+
+use std::sync::atomic::{AtomicU16, AtomicU32};
+
 use glam::{DVec3, Vec2};
 
 use crate::error::Result;
-use crate::parallel::{for_chunks, for_chunks_reporting, Report};
+use crate::parallel::{for_chunks, Report};
 use crate::sampling::{
     surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap, CELL_UNITS,
 };
@@ -62,7 +66,7 @@ pub(crate) fn compute(
         cells: layout.cells.len(),
         ..AreaStats::default()
     };
-    let cx = Shares {
+    let splitter = split::Splitter {
         samples,
         maps,
         index,
@@ -70,12 +74,19 @@ pub(crate) fn compute(
         vis,
         alpha,
     };
-    let chunks = cx.split(&layout, threads, report)?;
-    for chunk in &chunks {
-        stats.queries += chunk.queries;
-        stats.orphan_cells += chunk.orphans;
+    let runs = splitter.count(&layout, threads, report)?;
+    for run in &runs {
+        stats.queries += run.queries;
+        stats.orphan_cells += run.orphans;
     }
-    gather_shares(samples, maps, layout, chunks, &redo);
+    gather_shares(
+        samples,
+        (maps, index, obstruction, vis, alpha),
+        layout,
+        runs,
+        &redo,
+        threads,
+    )?;
     region_centroids(samples, threads)?;
     Ok(stats)
 }
@@ -208,16 +219,24 @@ fn lay_cells(
 }
 
 /// Gathers the shares by sample, in cell order within each sample (a counting sort): a sample
-/// on a kept side keeps its shares (their cells renumbered), the others take the new ones.
-/// Each input is freed as soon as it has been read, so the old and new arrays are not all
-/// held at once.
+/// on a kept side keeps its shares (their cells renumbered), the others take the new ones,
+/// written in place by the second pass of the split. The old shares are freed before the new
+/// array is allocated (kept ones copied out first), so the two are not held at once.
 fn gather_shares(
     samples: &mut Samples,
-    maps: &[SurfaceMap],
+    cx: (
+        &[SurfaceMap],
+        &SideIndex,
+        &Obstruction,
+        &dyn Visibility,
+        f32,
+    ),
     layout: Layout,
-    chunks: Vec<CellShares>,
+    mut runs: Vec<split::Run>,
     redo: &dyn Fn(usize) -> bool,
-) {
+    threads: usize,
+) -> Result<()> {
+    let (maps, index, obstruction, vis, alpha) = cx;
     let n = samples.len();
     let kept_sample =
         |k: usize| !redo(samples.side[k] as usize) && k + 1 < samples.share_start.len();
@@ -227,51 +246,58 @@ fn gather_shares(
             start[k + 1] = samples.share_range(k).len() as u32;
         }
     }
-    for chunk in &chunks {
-        for &k in &chunk.samples {
-            start[k as usize + 1] += 1;
-        }
+    for (k, count) in split::counts(&runs) {
+        start[k as usize + 1] += count;
     }
     for k in 0..n {
         start[k + 1] += start[k];
     }
-    let mut shares = vec![0u32; start[n] as usize];
-    let mut units = vec![0u16; start[n] as usize];
-    let mut area = vec![0.0f64; n];
-    let mut next = start.clone();
-    for k in 0..n {
-        if kept_sample(k) {
-            area[k] = samples.shares_of(k).map(|(_, a)| f64::from(a)).sum();
-            for i in samples.share_range(k) {
-                let at = next[k] as usize;
-                shares[at] = layout.moved[samples.shares[i] as usize];
-                units[at] = samples.share_units[i];
-                next[k] += 1;
-            }
-        }
-    }
+    let kept: Vec<(u32, u16)> = (0..n)
+        .filter(|&k| kept_sample(k))
+        .flat_map(|k| samples.share_range(k))
+        .map(|i| {
+            let c = samples.shares[i] as usize;
+            (
+                layout.moved.get(c).copied().unwrap_or(0),
+                samples.share_units[i],
+            )
+        })
+        .collect();
     samples.shares = Vec::new();
     samples.share_units = Vec::new();
-    let mut cell = 0usize;
-    for chunk in chunks {
-        let mut run = chunk.samples.iter().zip(&chunk.units);
-        for &count in &chunk.counts {
-            let unit = f64::from(layout.cells[cell].area) / f64::from(CELL_UNITS);
-            for (&k, &u) in run.by_ref().take(count as usize) {
-                let k = k as usize;
-                area[k] += f64::from(u) * unit;
+    let total = start[n] as usize;
+    let mut shares: Vec<AtomicU32> = (0..total).map(|_| AtomicU32::new(0)).collect();
+    let mut units: Vec<AtomicU16> = (0..total).map(|_| AtomicU16::new(0)).collect();
+    let mut next = start.clone();
+    let mut kept = kept.into_iter();
+    for k in 0..n {
+        if kept_sample(k) {
+            // A kept sample holds only its old shares (the old array is gone by now).
+            let count = (start[k + 1] - start[k]) as usize;
+            for (c, u) in kept.by_ref().take(count) {
                 let at = next[k] as usize;
-                shares[at] = cell as u32;
-                units[at] = u;
+                *shares[at].get_mut() = c;
+                *units[at].get_mut() = u;
                 next[k] += 1;
             }
-            cell += 1;
         }
     }
+    split::place(&mut runs, &mut next);
+    let splitter = split::Splitter {
+        samples,
+        maps,
+        index,
+        obstruction,
+        vis,
+        alpha,
+    };
+    splitter.fill(&layout, &mut runs, threads, (&shares, &units))?;
+    drop(runs);
+    // Same size and alignment: collected in place, without a second array.
+    samples.shares = shares.into_iter().map(AtomicU32::into_inner).collect();
+    samples.share_units = units.into_iter().map(AtomicU16::into_inner).collect();
     samples.share_start = start;
-    samples.shares = shares;
-    samples.share_units = units;
-    samples.area = area;
+
     let old = std::mem::take(&mut samples.cells);
     let cell_start = layout.start;
     // A kept side keeps its cells' width; a side without cells has none.
@@ -297,9 +323,30 @@ fn gather_shares(
             }
         }));
     }
+    drop(old);
     samples.cells = cells;
     samples.cell_start = cell_start;
     samples.cell_half = cell_half;
+
+    // Each sample's area: the sum of its shares, in their order.
+    let mut area = std::mem::take(&mut samples.area);
+    area.resize(n, 0.0);
+    let shared: &Samples = samples;
+    for_chunks(&mut area, 4096, threads, |first, chunk| {
+        for (a, k) in chunk.iter_mut().zip(first..) {
+            *a = shared
+                .share_range(k)
+                .map(|i| {
+                    let cell = shared.cells[shared.shares[i] as usize].area;
+                    f64::from(shared.share_units[i]) * f64::from(cell)
+                })
+                .sum::<f64>()
+                / f64::from(CELL_UNITS);
+        }
+        Ok(())
+    })?;
+    samples.area = area;
+    Ok(())
 }
 
 /// Each sample's region centroid: the area-weighted centre of its shares (its position if it
@@ -325,165 +372,6 @@ fn region_centroids(samples: &mut Samples, threads: usize) -> Result<()> {
     })?;
     samples.centroid = centroids;
     Ok(())
-}
-
-/// The shares of a run of cells, in cell order: how many each cell of the run has (none for a
-/// kept cell), and the sample and units (of [`CELL_UNITS`]) of each share.
-#[derive(Clone, Debug, Default)]
-struct CellShares {
-    /// Whether the run was split (a stopped computation leaves later runs undone).
-    done: bool,
-    counts: Vec<u32>,
-    samples: Vec<u32>,
-    units: Vec<u16>,
-    /// Cells with no visible sample within R, given to the nearest one.
-    orphans: usize,
-    queries: u64,
-}
-
-impl CellShares {
-    fn len(&self) -> usize {
-        self.samples.len()
-    }
-
-    /// A whole cell to sample k.
-    fn whole(&mut self, k: u32) {
-        self.samples.push(k);
-        self.units.push(CELL_UNITS as u16);
-    }
-}
-
-/// What splitting a cell among samples reads.
-struct Shares<'a> {
-    samples: &'a Samples,
-    maps: &'a [SurfaceMap],
-    index: &'a SideIndex,
-    obstruction: &'a Obstruction,
-    vis: &'a dyn Visibility,
-    alpha: f32,
-}
-
-/// Cells per parallel chunk of the split.
-const CHUNK: usize = 1024;
-
-impl Shares<'_> {
-    /// Splits the new cells among their samples (eq. 5), in parallel chunks of cells; each
-    /// chunk's shares (cell, sample, area) in cell order. Cells a Stop left unsplit go whole to
-    /// their nearest sample.
-    fn split(&self, layout: &Layout, threads: usize, report: Report) -> Result<Vec<CellShares>> {
-        let cells = &layout.cells;
-        let mut chunks: Vec<CellShares> = vec![CellShares::default(); cells.len().div_ceil(CHUNK)];
-        let split = |c: usize, out: &mut [CellShares]| {
-            let (mut near, mut units) = (Vec::new(), Vec::new());
-            let out = &mut out[0];
-            out.done = true;
-            let ids = c * CHUNK..((c + 1) * CHUNK).min(cells.len());
-            out.counts.reserve_exact(ids.len());
-            for (cell, id) in cells[ids.clone()].iter().zip(ids) {
-                let before = out.len();
-                if cell.is_new() {
-                    let side = layout.side_of(id);
-                    let map = &self.maps[surface_of(side) as usize];
-                    self.of_cell(side, cell, map, (&mut near, &mut units), out)?;
-                }
-                out.counts.push((out.len() - before) as u32);
-            }
-            out.samples.shrink_to_fit();
-            out.units.shrink_to_fit();
-            Ok(())
-        };
-        if !for_chunks_reporting(&mut chunks, 1, threads, split, report)? {
-            for (c, chunk) in chunks.iter_mut().enumerate().filter(|(_, c)| !c.done) {
-                let ids = c * CHUNK..((c + 1) * CHUNK).min(cells.len());
-                chunk.counts.clear();
-                chunk.samples.clear();
-                chunk.units.clear();
-                for (cell, id) in cells[ids.clone()].iter().zip(ids) {
-                    let side = layout.side_of(id);
-                    let nearest = self.index.nearest(self.samples, side, cell.centroid);
-                    match nearest.filter(|_| cell.is_new()) {
-                        Some(k) => {
-                            chunk.whole(k);
-                            chunk.counts.push(1);
-                        }
-                        None => chunk.counts.push(0),
-                    }
-                }
-            }
-        }
-        Ok(chunks)
-    }
-
-    /// Splits a new cell among the samples of its side within R of it (eq. 5), into `out`.
-    fn of_cell(
-        &self,
-        side: u32,
-        cell: &Laid,
-        map: &SurfaceMap,
-        (near, units): (&mut Vec<(u32, f32)>, &mut Vec<u16>),
-        out: &mut CellShares,
-    ) -> Result<()> {
-        let (samples, index) = (self.samples, self.index);
-        let centroid = cell.centroid;
-        let Some(nearest) = index.nearest(samples, side, centroid) else {
-            return Ok(());
-        };
-        let r = 2.0 * samples.radius[nearest as usize];
-        index.within(samples, side, centroid, r, near);
-        let point = map.to_3d(centroid);
-        out.queries += self
-            .obstruction
-            .retain_visible(self.vis, self.maps, samples, side, point, near)?;
-        if near.is_empty() {
-            // Sealed off within R: the nearest sample it sees further out, else the nearest.
-            out.orphans += 1;
-            index.within(samples, side, centroid, 4.0 * r, near);
-            near.sort_unstable_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)));
-            near.truncate(16);
-            out.queries += self
-                .obstruction
-                .retain_visible(self.vis, self.maps, samples, side, point, near)?;
-            let k = near.first().map_or(nearest, |n| n.0);
-            out.whole(k);
-            return Ok(());
-        }
-        // Ascending sample order: the sum does not depend on the grid's iteration order.
-        near.sort_unstable_by_key(|&(k, _)| k);
-        let weight = |d2: f32| f64::from((-self.alpha * d2.sqrt() / r).exp());
-        let total: f64 = near.iter().map(|&(_, d2)| weight(d2)).sum();
-        let parts = near.iter().map(|&(_, d2)| weight(d2) / total);
-        split_units(parts, units);
-        for (&(k, _), &u) in near.iter().zip(units.iter()) {
-            if u > 0 {
-                out.samples.push(k);
-                out.units.push(u);
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Splits a cell's [`CELL_UNITS`] among parts (fractions adding up to 1) by largest
-/// remainders, so that the units add up to the whole cell exactly; ties go to the earlier part.
-fn split_units(parts: impl Iterator<Item = f64>, units: &mut Vec<u16>) {
-    let whole = f64::from(CELL_UNITS);
-    let mut rest: Vec<(f64, usize)> = Vec::new();
-    units.clear();
-    let mut given = 0u32;
-    for (i, p) in parts.enumerate() {
-        let exact = (p * whole).clamp(0.0, whole);
-        let u = exact.floor();
-        units.push(u as u16);
-        given += u as u32;
-        rest.push((exact - u, i));
-    }
-    let short = CELL_UNITS.saturating_sub(given) as usize;
-    if short > 0 {
-        rest.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        for &(_, i) in rest.iter().cycle().take(short) {
-            units[i] = units[i].saturating_add(1);
-        }
-    }
 }
 
 /// A side's clipped cells: the grid's cell size, and (key, area, centroid) of each cell.
@@ -600,18 +488,18 @@ mod tests {
         // By hand: 65535 x (1/2, 1/4, 1/4) = 32767.5, 16383.75, 16383.75; the floors leave 2
         // units, which go to the two largest remainders (0.75 each).
         let mut units = Vec::new();
-        split_units([0.5, 0.25, 0.25].into_iter(), &mut units);
+        split::split_units([0.5, 0.25, 0.25].into_iter(), &mut units);
         assert_eq!(units, [32767, 16384, 16384]);
         // Any split: the whole cell, each part within one unit of its exact share.
         let parts: Vec<f64> = (1..=13).map(|i| f64::from(i * i)).collect();
         let total: f64 = parts.iter().sum();
-        split_units(parts.iter().map(|p| p / total), &mut units);
+        split::split_units(parts.iter().map(|p| p / total), &mut units);
         assert_eq!(units.iter().map(|&u| u32::from(u)).sum::<u32>(), CELL_UNITS);
         for (p, &u) in parts.iter().zip(&units) {
             assert!((p / total * f64::from(CELL_UNITS) - f64::from(u)).abs() < 1.0);
         }
         // One part takes it all.
-        split_units([1.0].into_iter(), &mut units);
+        split::split_units([1.0].into_iter(), &mut units);
         assert_eq!(units, [u16::MAX]);
     }
 
