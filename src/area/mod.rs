@@ -13,12 +13,11 @@
 
 mod split;
 
-use std::sync::atomic::{AtomicU16, AtomicU32};
-
 use glam::{DVec3, Vec2};
 
 use crate::error::Result;
 use crate::parallel::{for_chunks, Report};
+use crate::sampling::shares::{self, Shares};
 use crate::sampling::{
     surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap, CELL_UNITS,
 };
@@ -238,12 +237,13 @@ fn gather_shares(
 ) -> Result<()> {
     let (maps, index, obstruction, vis, alpha) = cx;
     let n = samples.len();
-    let kept_sample =
-        |k: usize| !redo(samples.side[k] as usize) && k + 1 < samples.share_start.len();
+    // Samples of the last computation on sides that did not change keep their shares.
+    let old_starts = samples.shares.start.len();
+    let kept_sample = |k: usize| !redo(samples.side[k] as usize) && k + 1 < old_starts;
     let mut start = vec![0u32; n + 1];
     for k in 0..n {
         if kept_sample(k) {
-            start[k + 1] = samples.share_range(k).len() as u32;
+            start[k + 1] = samples.shares.range(k).len() as u32;
         }
     }
     for (k, count) in split::counts(&runs) {
@@ -254,35 +254,29 @@ fn gather_shares(
     }
     let kept: Vec<(u32, u16)> = (0..n)
         .filter(|&k| kept_sample(k))
-        .flat_map(|k| samples.share_range(k))
-        .map(|i| {
-            let c = samples.shares[i] as usize;
-            (
-                layout.moved.get(c).copied().unwrap_or(0),
-                samples.share_units[i],
-            )
-        })
+        .flat_map(|k| samples.shares.of(k))
+        .map(|(c, u)| (layout.moved.get(c as usize).copied().unwrap_or(0), u))
         .collect();
-    samples.shares = Vec::new();
-    samples.share_units = Vec::new();
-    let total = start[n] as usize;
-    let mut shares: Vec<AtomicU32> = (0..total).map(|_| AtomicU32::new(0)).collect();
-    let mut units: Vec<AtomicU16> = (0..total).map(|_| AtomicU16::new(0)).collect();
+    samples.shares = Shares::default();
     let mut next = start.clone();
+    let writer = shares::Writer::new(start);
+    // Per sample: the cell of its last share written so far.
+    let mut last = vec![split::NONE; n];
     let mut kept = kept.into_iter();
     for k in 0..n {
         if kept_sample(k) {
             // A kept sample holds only its old shares (the old array is gone by now).
-            let count = (start[k + 1] - start[k]) as usize;
+            let count = (next[k + 1] - next[k]) as usize;
             for (c, u) in kept.by_ref().take(count) {
-                let at = next[k] as usize;
-                *shares[at].get_mut() = c;
-                *units[at].get_mut() = u;
+                let previous = (last[k] != split::NONE).then_some(last[k]);
+                writer.write(next[k] as usize, k, previous, c, u);
+                last[k] = c;
                 next[k] += 1;
             }
         }
     }
-    split::place(&mut runs, &mut next);
+    split::place(&mut runs, &mut next, &mut last);
+    drop((next, last));
     let splitter = split::Splitter {
         samples,
         maps,
@@ -291,12 +285,9 @@ fn gather_shares(
         vis,
         alpha,
     };
-    splitter.fill(&layout, &mut runs, threads, (&shares, &units))?;
+    splitter.fill(&layout, &mut runs, threads, &writer)?;
     drop(runs);
-    // Same size and alignment: collected in place, without a second array.
-    samples.shares = shares.into_iter().map(AtomicU32::into_inner).collect();
-    samples.share_units = units.into_iter().map(AtomicU16::into_inner).collect();
-    samples.share_start = start;
+    samples.shares = writer.finish();
 
     let old = std::mem::take(&mut samples.cells);
     let cell_start = layout.start;
@@ -335,10 +326,11 @@ fn gather_shares(
     for_chunks(&mut area, 4096, threads, |first, chunk| {
         for (a, k) in chunk.iter_mut().zip(first..) {
             *a = shared
-                .share_range(k)
-                .map(|i| {
-                    let cell = shared.cells[shared.shares[i] as usize].area;
-                    f64::from(shared.share_units[i]) * f64::from(cell)
+                .shares
+                .of(k)
+                .map(|(c, u)| {
+                    let cell = shared.cells.get(c as usize).map_or(0.0, |c| c.area);
+                    f64::from(u) * f64::from(cell)
                 })
                 .sum::<f64>()
                 / f64::from(CELL_UNITS);
@@ -487,19 +479,19 @@ mod tests {
     fn a_cell_is_split_into_units_that_add_up_to_it() {
         // By hand: 65535 x (1/2, 1/4, 1/4) = 32767.5, 16383.75, 16383.75; the floors leave 2
         // units, which go to the two largest remainders (0.75 each).
-        let mut units = Vec::new();
-        split::split_units([0.5, 0.25, 0.25].into_iter(), &mut units);
+        let (mut units, mut rest) = (Vec::new(), Vec::new());
+        split::split_units([0.5, 0.25, 0.25].into_iter(), &mut units, &mut rest);
         assert_eq!(units, [32767, 16384, 16384]);
         // Any split: the whole cell, each part within one unit of its exact share.
         let parts: Vec<f64> = (1..=13).map(|i| f64::from(i * i)).collect();
         let total: f64 = parts.iter().sum();
-        split::split_units(parts.iter().map(|p| p / total), &mut units);
+        split::split_units(parts.iter().map(|p| p / total), &mut units, &mut rest);
         assert_eq!(units.iter().map(|&u| u32::from(u)).sum::<u32>(), CELL_UNITS);
         for (p, &u) in parts.iter().zip(&units) {
             assert!((p / total * f64::from(CELL_UNITS) - f64::from(u)).abs() < 1.0);
         }
         // One part takes it all.
-        split::split_units([1.0].into_iter(), &mut units);
+        split::split_units([1.0].into_iter(), &mut units, &mut rest);
         assert_eq!(units, [u16::MAX]);
     }
 

@@ -10,18 +10,31 @@
 //! shares by cell is ever held beside the array by sample. The runs are fixed, so the shares'
 //! order (cell order within each sample) does not depend on the thread count.
 
-use std::sync::atomic::{AtomicU16, AtomicU32, Ordering};
-
 use glam::Vec2;
 
 use super::{Laid, Layout};
 use crate::error::{Error, Result};
 use crate::parallel::{for_chunks, for_chunks_reporting, Report};
-use crate::sampling::{surface_of, Obstruction, Samples, Side, SideIndex, SurfaceMap, CELL_UNITS};
+use crate::sampling::shares::{Writer, WHOLE};
+use crate::sampling::{surface_of, Obstruction, Samples, Side, SideIndex, SurfaceMap};
 use crate::visibility::Visibility;
 
 /// Cells per run.
 const RUN: usize = 1024;
+
+/// No cell (a sample's first share has no previous one).
+pub(super) const NONE: u32 = u32::MAX;
+
+/// One sample's shares from one run.
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    sample: u32,
+    /// How many (first pass); then the slot of its next share.
+    next: u32,
+    /// The cell of its last share in the run (first pass); then the cell of its share before
+    /// the next one ([`NONE`] before its first).
+    prev: u32,
+}
 
 /// What splitting a cell among samples reads.
 pub(super) struct Splitter<'a> {
@@ -39,9 +52,8 @@ pub(super) struct Run {
     /// Whether the run was split; a stopped computation gives later runs' cells whole to
     /// their nearest samples.
     done: bool,
-    /// (sample, shares it gets from the run) in sample order; once placed, (sample, the slot
-    /// of its next share).
-    slots: Vec<(u32, u32)>,
+    /// The samples the run gives shares to, in sample order.
+    slots: Vec<Slot>,
     /// The visibility answers of the run's cells on obstructed sides, in the order asked.
     seen: Bits,
     /// Cells with no visible sample within R, given to the nearest one.
@@ -91,6 +103,7 @@ enum Answers<'r> {
 struct Scratch {
     near: Vec<(u32, f32)>,
     units: Vec<u16>,
+    rest: Vec<(f64, usize)>,
 }
 
 impl Splitter<'_> {
@@ -123,7 +136,7 @@ impl Splitter<'_> {
                         .near
                         .iter()
                         .zip(&scratch.units)
-                        .filter_map(|(&(k, _), &u)| (u > 0).then_some(k)),
+                        .filter_map(|(&(k, _), &u)| (u > 0).then_some((k, id as u32))),
                 );
             }
             run.seen.words.shrink_to_fit();
@@ -135,52 +148,55 @@ impl Splitter<'_> {
             for (r, run) in runs.iter_mut().enumerate().filter(|(_, run)| !run.done) {
                 let nearest = (r * RUN..((r + 1) * RUN).min(cells.len()))
                     .filter(|&id| cells[id].is_new())
-                    .filter_map(|id| self.nearest(layout.side_of(id), cells[id].centroid));
+                    .filter_map(|id| {
+                        let k = self.nearest(layout.side_of(id), cells[id].centroid)?;
+                        Some((k, id as u32))
+                    });
                 run.slots = tally(nearest.collect());
             }
         }
         Ok(runs)
     }
 
-    /// The second pass: every run's shares written into the slots `place` gave its samples,
-    /// as (cell, units) in `shares` and `units`.
+    /// The second pass: every run's shares written into the slots `place` gave its samples.
     pub fn fill(
         &self,
         layout: &Layout,
         runs: &mut [Run],
         threads: usize,
-        (shares, units): (&[AtomicU32], &[AtomicU16]),
+        writer: &Writer,
     ) -> Result<()> {
         let cells = &layout.cells;
         let fill = |r: usize, out: &mut [Run]| {
             let run = &mut out[0];
-            let mut write = |k: u32, id: usize, u: u16| -> Result<()> {
-                let slot = match run.slots.binary_search_by_key(&k, |s| s.0) {
+            let mut write = |k: u32, id: usize, units: u16| -> Result<()> {
+                let written = match run.slots.binary_search_by_key(&k, |s| s.sample) {
                     Ok(i) => {
-                        run.slots[i].1 += 1;
-                        run.slots[i].1 - 1
+                        let slot = &mut run.slots[i];
+                        let previous = (slot.prev != NONE).then_some(slot.prev);
+                        let at = slot.next as usize;
+                        slot.next += 1;
+                        slot.prev = id as u32;
+                        writer.write(at, k as usize, previous, id as u32, units)
                     }
-                    Err(_) => u32::MAX,
-                } as usize;
-                match (shares.get(slot), units.get(slot)) {
-                    (Some(s), Some(v)) => {
-                        s.store(id as u32, Ordering::Relaxed);
-                        v.store(u, Ordering::Relaxed);
-                        Ok(())
-                    }
-                    _ => Err(Error::Worker {
+                    Err(_) => false,
+                };
+                if written {
+                    Ok(())
+                } else {
+                    Err(Error::Worker {
                         problem: format!(
                             "splitting area cell {id}: sample {k} was not counted (the \
                              visibility backend answered differently)"
                         ),
-                    }),
+                    })
                 }
             };
             let ids = r * RUN..((r + 1) * RUN).min(cells.len());
             if !run.done {
                 for id in ids.filter(|&id| cells[id].is_new()) {
                     if let Some(k) = self.nearest(layout.side_of(id), cells[id].centroid) {
-                        write(k, id, CELL_UNITS as u16)?;
+                        write(k, id, WHOLE)?;
                     }
                 }
                 return Ok(());
@@ -216,7 +232,7 @@ impl Splitter<'_> {
         scratch: &mut Scratch,
     ) -> Result<bool> {
         let (samples, index) = (self.samples, self.index);
-        let Scratch { near, units } = scratch;
+        let Scratch { near, units, rest } = scratch;
         near.clear();
         units.clear();
         let centroid = cell.centroid;
@@ -237,14 +253,14 @@ impl Splitter<'_> {
             let k = near.first().map_or(nearest, |n| n.0);
             near.clear();
             near.push((k, 0.0));
-            units.push(CELL_UNITS as u16);
+            units.push(WHOLE);
             return Ok(true);
         }
         // Ascending sample order: the sum does not depend on the grid's iteration order.
         near.sort_unstable_by_key(|&(k, _)| k);
         let weight = |d2: f32| f64::from((-self.alpha * d2.sqrt() / r).exp());
         let total: f64 = near.iter().map(|&(_, d2)| weight(d2)).sum();
-        split_units(near.iter().map(|&(_, d2)| weight(d2) / total), units);
+        split_units(near.iter().map(|&(_, d2)| weight(d2) / total), units, rest);
         Ok(false)
     }
 
@@ -294,25 +310,36 @@ impl Splitter<'_> {
     }
 }
 
-/// (sample, how many times it occurs), in sample order.
-fn tally(mut samples: Vec<u32>) -> Vec<(u32, u32)> {
-    samples.sort_unstable();
-    let mut out: Vec<(u32, u32)> = Vec::new();
-    for k in samples {
+/// Each sample's shares from a run, from its (sample, cell) pairs.
+fn tally(mut shares: Vec<(u32, u32)>) -> Vec<Slot> {
+    shares.sort_unstable();
+    let mut out: Vec<Slot> = Vec::new();
+    for (k, cell) in shares {
         match out.last_mut() {
-            Some(last) if last.0 == k => last.1 += 1,
-            _ => out.push((k, 1)),
+            Some(last) if last.sample == k => {
+                last.next += 1;
+                last.prev = cell;
+            }
+            _ => out.push(Slot {
+                sample: k,
+                next: 1,
+                prev: cell,
+            }),
         }
     }
     out.shrink_to_fit();
     out
 }
 
-/// Splits a cell's [`CELL_UNITS`] among parts (fractions adding up to 1) by largest
+/// Splits a cell's [`CELL_UNITS`](crate::sampling::CELL_UNITS) among parts (fractions adding up to 1) by largest
 /// remainders, so that the units add up to the whole cell exactly; ties go to the earlier part.
-pub(super) fn split_units(parts: impl Iterator<Item = f64>, units: &mut Vec<u16>) {
-    let whole = f64::from(CELL_UNITS);
-    let mut rest: Vec<(f64, usize)> = Vec::new();
+pub(super) fn split_units(
+    parts: impl Iterator<Item = f64>,
+    units: &mut Vec<u16>,
+    rest: &mut Vec<(f64, usize)>,
+) {
+    let whole = f64::from(crate::sampling::CELL_UNITS);
+    rest.clear();
     units.clear();
     let mut given = 0u32;
     for (i, p) in parts.enumerate() {
@@ -322,7 +349,7 @@ pub(super) fn split_units(parts: impl Iterator<Item = f64>, units: &mut Vec<u16>
         given += u as u32;
         rest.push((exact - u, i));
     }
-    let short = CELL_UNITS.saturating_sub(given) as usize;
+    let short = crate::sampling::CELL_UNITS.saturating_sub(given) as usize;
     if short > 0 {
         rest.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         for &(_, i) in rest.iter().cycle().take(short) {
@@ -332,18 +359,23 @@ pub(super) fn split_units(parts: impl Iterator<Item = f64>, units: &mut Vec<u16>
 }
 
 /// Gives each run the slots its samples' shares go to: after `next[k]` (the first free slot of
-/// sample k), in run order, so that each sample's shares lie in cell order.
-pub(super) fn place(runs: &mut [Run], next: &mut [u32]) {
+/// sample k), in run order, so that each sample's shares lie in cell order; and the cell each
+/// run's first share of a sample follows (`last[k]`: the cell of sample k's last share so far).
+pub(super) fn place(runs: &mut [Run], next: &mut [u32], last: &mut [u32]) {
     for run in runs {
-        for (k, count) in &mut run.slots {
-            let first = next[*k as usize];
-            next[*k as usize] += *count;
-            *count = first;
+        for slot in &mut run.slots {
+            let k = slot.sample as usize;
+            let (count, run_last) = (slot.next, slot.prev);
+            slot.next = next[k];
+            slot.prev = last[k];
+            next[k] += count;
+            last[k] = run_last;
         }
     }
 }
 
-/// The shares each run gives each sample: (sample, count) pairs.
+/// The shares each run gives each sample, before `place`: (sample, count) pairs.
 pub(super) fn counts(runs: &[Run]) -> impl Iterator<Item = (u32, u32)> + '_ {
-    runs.iter().flat_map(|r| r.slots.iter().copied())
+    runs.iter()
+        .flat_map(|r| r.slots.iter().map(|s| (s.sample, s.next)))
 }

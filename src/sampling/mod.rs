@@ -7,12 +7,14 @@ pub(crate) mod cover;
 pub mod obstruction;
 pub mod poisson;
 pub(crate) mod reflectance;
+pub(crate) mod shares;
 pub mod surface_map;
 
 use glam::{Vec2, Vec3};
 
 use crate::scene::Scene;
 pub use obstruction::Obstruction;
+pub(crate) use shares::Shares;
 pub use surface_map::SurfaceMap;
 
 /// A cell's whole area in share units: a cell is split among its samples in parts of
@@ -72,17 +74,10 @@ pub struct Samples {
     /// Centroid of each sample's shares of area (its region): form factors are taken between
     /// region centroids, since a sample's radiosity stands for its region's average.
     pub(crate) centroid: Vec<Vec3>,
-    /// The shares of area cells each sample holds (eq. 5): sample k's are
-    /// `shares[share_start[k]..share_start[k+1]]`, each a cell index, with its part of the cell
-    /// in `share_units` (of [`CELL_UNITS`]). The shares of a cell add up to the cell exactly, so
-    /// they tile the surfaces; near shooters are integrated over them. (Memory: 6 bytes a share
-    /// instead of 8 with an f32 area; a unit is 1.5e-5 of a cell, far below the quadrature's
-    /// own error.)
-    pub(crate) shares: Vec<u32>,
-    /// Each share's part of its cell, in units of 1 / [`CELL_UNITS`].
-    pub(crate) share_units: Vec<u16>,
-    /// Offsets into `shares` (length samples + 1 once areas are computed).
-    pub(crate) share_start: Vec<u32>,
+    /// The shares of area cells each sample holds (eq. 5), 4 bytes each (see [`Shares`]).
+    /// The shares of a cell add up to the cell exactly, so they tile the surfaces; near
+    /// shooters are integrated over them.
+    pub(crate) shares: Shares,
     /// The area cells (pieces of surface), side by side in side order.
     pub(crate) cells: Vec<AreaCell>,
     /// Per side: where its cells start in `cells` (length sides + 1 once areas are computed).
@@ -180,7 +175,7 @@ impl Samples {
                 + vec_bytes(&self.round)
                 + vec_bytes(&self.reflectance),
             vec_bytes(&self.cells) + vec_bytes(&self.cell_start) + vec_bytes(&self.cell_half),
-            vec_bytes(&self.shares) + vec_bytes(&self.share_units) + vec_bytes(&self.share_start),
+            self.shares.bytes(),
         )
     }
 
@@ -241,31 +236,12 @@ impl Samples {
         self.reflectance.shrink_to_fit();
     }
 
-    /// Where sample k's shares lie in `shares` (empty where it holds none or the offsets do
-    /// not fit the arrays).
-    pub(crate) fn share_range(&self, k: usize) -> std::ops::Range<usize> {
-        match (self.share_start.get(k), self.share_start.get(k + 1)) {
-            (Some(&a), Some(&b))
-                if a <= b
-                    && b as usize <= self.shares.len()
-                    && b as usize <= self.share_units.len() =>
-            {
-                a as usize..b as usize
-            }
-            _ => 0..0,
-        }
-    }
-
     /// Sample k's shares of area cells: (cell index, area).
     pub(crate) fn shares_of(&self, k: usize) -> impl Iterator<Item = (u32, f32)> + '_ {
-        let range = self.share_range(k);
-        self.shares[range.clone()]
-            .iter()
-            .zip(&self.share_units[range])
-            .map(|(&c, &units)| {
-                let area = self.cells.get(c as usize).map_or(0.0, |cell| cell.area);
-                (c, f32::from(units) * (area / CELL_UNITS as f32))
-            })
+        self.shares.of(k).map(|(c, units)| {
+            let area = self.cells.get(c as usize).map_or(0.0, |cell| cell.area);
+            (c, f32::from(units) * (area / CELL_UNITS as f32))
+        })
     }
 
     /// Checks the invariants the solver keeps (run in debug builds after every area
@@ -314,13 +290,12 @@ impl Samples {
                 }
             }
         }
-        if self.share_start.len() != n + 1 {
+        let start = &self.shares.start;
+        if start.len() != n + 1 {
             // Areas not computed yet: nothing more to check.
             return Ok(());
         }
-        if self.share_start.windows(2).any(|w| w[0] > w[1])
-            || self.share_start[n] as usize != self.shares.len()
-        {
+        if start.windows(2).any(|w| w[0] > w[1]) || start[n] as usize != self.shares.len() {
             return Err("share offsets out of order".into());
         }
         let mut per_cell = vec![0.0f64; self.cells.len()];

@@ -659,10 +659,10 @@ mod tests {
         // Shares that do not tile the cells.
         let mut broken = s.clone();
         // (The largest share, so that the cell's sum moves by more than the tolerance.)
-        let largest = (0..broken.samples.share_units.len())
-            .max_by_key(|&i| broken.samples.share_units[i])
-            .unwrap();
-        broken.samples.share_units[largest] /= 2;
+        let units = &broken.samples.shares.units;
+        let largest = (0..units.len()).max_by_key(|&i| units[i]).unwrap();
+        let half = units[largest] / 2;
+        broken.samples.shares.set_units(largest, half);
         let e = broken.validate().unwrap_err();
         assert!(
             e.contains("is not its shares'") || e.contains("shared out"),

@@ -268,6 +268,9 @@ fn sweep(
         let mut inputs = inputs.write().unwrap_or_else(|e| e.into_inner());
         inputs.unshot.clear();
         inputs.unshot.extend_from_slice(unshot);
+        // The old shooters go first: a node's shooter is 96 bytes, and there are about as
+        // many nodes as samples.
+        drop(std::mem::take(&mut inputs.shooters));
         inputs.shooters = shooters(tree, samples, unshot);
         inputs.scales.clear();
         inputs.scales.extend_from_slice(scales);
