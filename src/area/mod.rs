@@ -65,27 +65,19 @@ pub(crate) fn compute(
         cells: layout.cells.len(),
         ..AreaStats::default()
     };
-    let splitter = split::Splitter {
-        samples,
+    let reads = split::Reads {
         maps,
         index,
         obstruction,
         vis,
         alpha,
     };
-    let runs = splitter.count(&layout, threads, report)?;
+    let runs = split::Splitter::new(samples, reads).count(&layout, threads, report)?;
     for run in &runs {
         stats.queries += run.queries;
         stats.orphan_cells += run.orphans;
     }
-    gather_shares(
-        samples,
-        (maps, index, obstruction, vis, alpha),
-        layout,
-        runs,
-        &redo,
-        threads,
-    )?;
+    gather_shares(samples, reads, layout, runs, &redo, threads)?;
     region_centroids(samples, threads)?;
     Ok(stats)
 }
@@ -223,19 +215,13 @@ fn lay_cells(
 /// array is allocated (kept ones copied out first), so the two are not held at once.
 fn gather_shares(
     samples: &mut Samples,
-    cx: (
-        &[SurfaceMap],
-        &SideIndex,
-        &Obstruction,
-        &dyn Visibility,
-        f32,
-    ),
+    reads: split::Reads,
     layout: Layout,
     mut runs: Vec<split::Run>,
     redo: &dyn Fn(usize) -> bool,
     threads: usize,
 ) -> Result<()> {
-    let (maps, index, obstruction, vis, alpha) = cx;
+    let maps = reads.maps;
     let n = samples.len();
     // Samples of the last computation on sides that did not change keep their shares.
     let old_starts = samples.shares.start.len();
@@ -277,15 +263,7 @@ fn gather_shares(
     }
     split::place(&mut runs, &mut next, &mut last);
     drop((next, last));
-    let splitter = split::Splitter {
-        samples,
-        maps,
-        index,
-        obstruction,
-        vis,
-        alpha,
-    };
-    splitter.fill(&layout, &mut runs, threads, &writer)?;
+    split::Splitter::new(samples, reads).fill(&layout, &mut runs, threads, &writer)?;
     drop(runs);
     samples.shares = writer.finish();
 

@@ -36,14 +36,44 @@ struct Slot {
     prev: u32,
 }
 
-/// What splitting a cell among samples reads.
-pub(super) struct Splitter<'a> {
-    pub samples: &'a Samples,
+/// What splitting a cell among samples reads besides the samples.
+#[derive(Clone, Copy)]
+pub(super) struct Reads<'a> {
     pub maps: &'a [SurfaceMap],
     pub index: &'a SideIndex,
     pub obstruction: &'a Obstruction,
     pub vis: &'a dyn Visibility,
     pub alpha: f32,
+}
+
+/// Splits cells among `samples`.
+pub(super) struct Splitter<'a> {
+    samples: &'a Samples,
+    maps: &'a [SurfaceMap],
+    index: &'a SideIndex,
+    obstruction: &'a Obstruction,
+    vis: &'a dyn Visibility,
+    alpha: f32,
+}
+
+impl<'a> Splitter<'a> {
+    pub fn new(samples: &'a Samples, reads: Reads<'a>) -> Splitter<'a> {
+        let Reads {
+            maps,
+            index,
+            obstruction,
+            vis,
+            alpha,
+        } = reads;
+        Splitter {
+            samples,
+            maps,
+            index,
+            obstruction,
+            vis,
+            alpha,
+        }
+    }
 }
 
 /// What the first pass learned about a run of cells.
