@@ -36,7 +36,7 @@ fn main() -> ExitCode {
     // glibc gives each new thread an arena of its own up to 8 per core, and the solver's
     // parallel loops start threads often: freed memory then lies scattered over many arenas
     // and the resident peak grows by a fifth (the 2 x 2-room gallery: 2,430-2,690 bytes a
-    // sample in three runs; one arena per core 2,179-2,200; performance.md "Memory per sample").
+    // sample in three runs; one arena per core 2,197-2,248; performance.md "Memory per sample").
     // (A MALLOC_ARENA_MAX in the environment is the user's choice and stands.)
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     if std::env::var_os("MALLOC_ARENA_MAX").is_none() {

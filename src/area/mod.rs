@@ -121,7 +121,7 @@ impl Laid {
 impl Layout {
     /// The side cell `c` lies on.
     fn side_of(&self, c: usize) -> u32 {
-        (self.start.partition_point(|&s| s as usize <= c) as u32).saturating_sub(1)
+        crate::sampling::side_at(&self.start, c)
     }
 }
 

@@ -17,6 +17,12 @@ pub use obstruction::Obstruction;
 pub(crate) use shares::Shares;
 pub use surface_map::SurfaceMap;
 
+/// The side item `i` lies on, where `start[side]` is the first item of each side (items side
+/// by side in side order, as the area cells are).
+pub(crate) fn side_at(start: &[u32], i: usize) -> Side {
+    (start.partition_point(|&s| s as usize <= i) as u32).saturating_sub(1)
+}
+
 /// A cell's whole area in share units: a cell is split among its samples in parts of
 /// 1 / `CELL_UNITS` (see [`Samples`]' shares).
 pub(crate) const CELL_UNITS: u32 = u16::MAX as u32;
@@ -219,7 +225,7 @@ impl Samples {
 
     /// The side cell `c` lies on.
     pub(crate) fn side_of_cell(&self, c: usize) -> Side {
-        (self.cell_start.partition_point(|&s| s as usize <= c) as u32).saturating_sub(1)
+        side_at(&self.cell_start, c)
     }
 
     /// Gives back what the arrays hold beyond their length: samples are pushed one by one, and

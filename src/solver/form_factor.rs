@@ -14,7 +14,7 @@
 
 use glam::Vec3;
 
-use crate::sampling::{Samples, SurfaceMap};
+use crate::sampling::{Samples, SurfaceMap, CELL_UNITS};
 use crate::visibility::Segment;
 
 /// Receivers nearer than this many √S of the shooter are integrated over its shares of cells.
@@ -86,7 +86,8 @@ fn near_factor(samples: &Samples, shooter: &Shooter, x: Vec3, n: Vec3) -> f32 {
         .copied()
         .unwrap_or(0.0);
     let mut sum = 0.0f64;
-    for (c, share) in samples.shares_of(k) {
+    // The stored units are the fraction of the cell itself: no area to divide back out.
+    for (c, units) in samples.shares.of(k) {
         let cell = &samples.cells[c as usize];
         let d = x - cell.centroid;
         let r2 = d.length_squared();
@@ -94,7 +95,7 @@ fn near_factor(samples: &Samples, shooter: &Shooter, x: Vec3, n: Vec3) -> f32 {
         if cos_j <= 0.0 {
             continue;
         }
-        let fraction = f64::from(share / cell.area);
+        let fraction = f64::from(units) / f64::from(CELL_UNITS);
         if r2 < 16.0 * half * half {
             let h = 0.5 * cell.area.sqrt();
             let (u, v) = (shooter.u * h, shooter.v * h);
@@ -105,7 +106,8 @@ fn near_factor(samples: &Samples, shooter: &Shooter, x: Vec3, n: Vec3) -> f32 {
         } else {
             let cos_i = -n.dot(d);
             if cos_i > 0.0 {
-                sum += f64::from(cos_i * cos_j / (r2 * r2) * share / std::f32::consts::PI);
+                let share = fraction * f64::from(cell.area);
+                sum += f64::from(cos_i * cos_j / (r2 * r2) / std::f32::consts::PI) * share;
             }
         }
     }
