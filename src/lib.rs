@@ -48,6 +48,7 @@
 mod area;
 pub mod budget;
 pub mod diagnose;
+pub mod distributed;
 pub mod error;
 pub mod ies;
 mod light;

@@ -9,6 +9,7 @@ mod page;
 mod plan;
 mod plot;
 mod progress;
+mod ranks;
 mod reference;
 mod report;
 mod scale;
@@ -47,16 +48,25 @@ fn main() -> ExitCode {
         }
     }
     let args = Args::parse();
+    // MPI is finalised when the job drops, after everything else.
+    let _job = ranks::start();
     let loading = LoadOptions {
         max_reflectance: args.max_reflectance,
         strict: args.strict,
         camera: args.camera,
     };
-    match run(args.command, &loading) {
+    let result = match &args.command {
+        Command::Render(_) | Command::Lux { .. } | Command::Samples { .. } => Ok(()),
+        _ if ranks::ranks().size() > 1 => Err(anyhow::anyhow!(
+            "only render, lux and samples run on several ranks (`mpirun -np N meshlight render …`)"
+        )),
+        _ => Ok(()),
+    };
+    match result.and_then(|()| run(args.command, &loading)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("meshlight: error: {}", errors::explain(&e));
-            ExitCode::FAILURE
+            ranks::report_error(&format!("meshlight: error: {}", errors::explain(&e)));
+            ranks::fail()
         }
     }
 }
@@ -86,6 +96,9 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
             let vis = backend_from(&solve.knobs).build(&scene)?;
             diagnose(&scene, vis.as_ref())?;
             let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+            if !ranks::root() {
+                return Ok(());
+            }
             print!("{}", solve_summary(&scene, &solution, &options, vis.name()));
             let lux = meshlight::lux::LuxOptions {
                 light_samples: grid_light_samples.max(1),
@@ -182,6 +195,9 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         anyhow::bail!("--false-color works with --method meshless only");
     }
     let (scene, options) = solve_setup(&r.solve, loading)?;
+    if r.method != Method::Meshless && ranks::ranks().size() > 1 {
+        anyhow::bail!("--method {:?} runs on one rank only", r.method);
+    }
     let vis = backend_from(&r.solve.knobs).build(&scene)?;
     diagnose(&scene, vis.as_ref())?;
     // The image and what to say about how it was made, by each method.
@@ -202,6 +218,9 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         }
         Method::Meshless => {
             let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+            if !ranks::root() {
+                return Ok(());
+            }
             let preset = render_options_from(&r.solve.knobs, r.supersample, r.direct_rays)?;
             let render_options = meshlight::RenderOptions {
                 threads: options.threads,
@@ -324,6 +343,9 @@ fn samples(solve: &SolveArgs, output: &Path, loading: &LoadOptions) -> anyhow::R
     let vis = backend_from(&solve.knobs).build(&scene)?;
     diagnose(&scene, vis.as_ref())?;
     let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+    if !ranks::root() {
+        return Ok(());
+    }
     let radiosity = solution.radiosity();
     let mean = radiosity.iter().map(|b| b.element_sum() / 3.0).sum::<f64>()
         / radiosity.len().max(1) as f64

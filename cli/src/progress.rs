@@ -20,6 +20,7 @@ pub fn with_progress<T>(
     );
     bar.enable_steady_tick(Duration::from_millis(200));
     let result = call(&mut |p: &Progress| {
+        crate::ranks::injected_failure(p);
         bar.set_message(line(what, p));
         Control::Continue
     });
@@ -49,7 +50,7 @@ pub fn solve_with_progress(
         );
     }
     Ok(with_progress("solve", |progress| {
-        meshlight::solve(scene, vis, options, progress)
+        meshlight::solver::solve_distributed(scene, vis, options, crate::ranks::ranks(), progress)
     })?)
 }
 

@@ -413,6 +413,25 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         meshlight::budget::human_bytes(bytes as f64),
         meshlight::budget::human_bytes(o.memory_budget as f64),
     );
+    let size = crate::ranks::ranks().size();
+    if size > 1 {
+        // The round with the most links is what bounds a rank's memory.
+        if let Some(r) = s.rounds().iter().max_by_key(|r| r.shooting.links) {
+            let sh = &r.shooting;
+            // Each sweep and the row sums' sweep exchange once.
+            let exchanges = (sh.shots + 1).max(1);
+            let _ = writeln!(
+                out,
+                "ranks: {size}; links held per rank at most {} of {} ({:.2}x), round {}; rank 0 \
+                 received {} a sweep from the others",
+                sh.most_held_links,
+                sh.links,
+                sh.most_held_links as f64 / sh.links.max(1) as f64,
+                r.round,
+                meshlight::budget::human_bytes(sh.exchanged_bytes as f64 / exchanges as f64),
+            );
+        }
+    }
     let emitted = s.ledger().emitted.element_sum();
     // Adaptive rounds start new samples from interpolated light, which the ledger does not
     // follow: only a single solve's account adds up. Specular surfaces have no samples: what

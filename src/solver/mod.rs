@@ -318,6 +318,27 @@ pub fn solve(
     options: &Options,
     progress: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<Solution> {
+    solve_distributed(scene, vis, options, &crate::distributed::Single, progress)
+}
+
+/// [`solve`] spread over `ranks`: every rank calls it with the same scene and options, and
+/// every rank gets the whole solution, equal to one process's bit for bit (see
+/// [`distributed`](crate::distributed)). The hierarchy's links and sweeps are shared out; the
+/// flat solver runs whole on every rank. A [`Control::Stop`] during the sweeps stops every
+/// rank at the same sweep (elsewhere the host must answer alike on every rank).
+pub fn solve_distributed(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &Options,
+    ranks: &dyn crate::distributed::Ranks,
+    progress: &mut dyn FnMut(&Progress) -> Control,
+) -> Result<Solution> {
+    if ranks.rank() >= ranks.size() {
+        return Err(Error::argument(
+            "ranks",
+            format!("rank {} of {} ranks", ranks.rank(), ranks.size()),
+        ));
+    }
     let method = if options.flat() {
         Method::Flat
     } else {
@@ -326,7 +347,7 @@ pub fn solve(
     crate::parallel::guarded("the solver", || {
         let checked = crate::visibility::Checked::new(vis, scene);
         let vis: &dyn crate::visibility::Visibility = &checked;
-        solve_with(scene, vis, options, progress, method)
+        solve_with(scene, vis, options, ranks, progress, method)
     })
 }
 
@@ -343,6 +364,7 @@ fn solve_with(
     scene: &Scene,
     vis: &dyn Visibility,
     options: &Options,
+    ranks: &dyn crate::distributed::Ranks,
     progress: crate::progress::Callback,
     method: Method,
 ) -> Result<Solution> {
@@ -392,6 +414,7 @@ fn solve_with(
         lift,
         epsilon,
         reporter: Reporter::new(progress),
+        ranks,
     };
 
     // Round 0: Poisson disk on every reflecting side.
@@ -600,6 +623,7 @@ mod tests {
                 &scene,
                 vis.as_ref(),
                 &options,
+                &crate::distributed::Single,
                 &mut |_| Control::Continue,
                 method,
             )

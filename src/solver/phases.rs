@@ -36,6 +36,8 @@ pub(super) struct Solve<'a> {
     pub(super) lift: f32,
     pub(super) epsilon: f32,
     pub(super) reporter: Reporter<'a>,
+    /// The processes the solve is spread over (see `distributed`).
+    pub(super) ranks: &'a dyn crate::distributed::Ranks,
     /// The scene's specular surfaces and lights, where it has any (and the depth is not 0).
     pub(super) specular: Option<(Specular, Lights)>,
 }
@@ -373,6 +375,7 @@ impl Solve<'_> {
             specular: solution.specular.as_ref(),
         };
         let settings = Settings {
+            ranks: self.ranks,
             threads: options.threads.max(1),
             capacity: options.pipeline_capacity.max(1),
             tolerance: options.tolerance,

@@ -32,7 +32,9 @@ pub(crate) struct State<'a> {
 }
 
 /// Settings of one solve.
-pub(crate) struct Settings {
+pub(crate) struct Settings<'a> {
+    /// The processes this solve is spread over ([`Single`](crate::distributed::Single) alone).
+    pub ranks: &'a dyn crate::distributed::Ranks,
     pub threads: usize,
     /// Jobs in flight in the pipeline at most.
     pub capacity: usize,

@@ -45,6 +45,13 @@ pub struct ShootStats {
     pub links: u64,
     /// Of those, links between two single samples.
     pub leaf_links: u64,
+    /// Links this process holds: all of them in one process, its receivers' share of them when
+    /// the solve is spread over ranks ([`solve_distributed`](crate::solver::solve_distributed)).
+    pub held_links: u64,
+    /// The most links any one rank holds (`held_links` in one process).
+    pub most_held_links: u64,
+    /// Bytes this rank received from the others in the sweeps' exchanges (0 in one process).
+    pub exchanged_bytes: u64,
     /// Unshot power / emitted power at the start.
     pub initial_unshot_fraction: f64,
     /// Unshot power / emitted power at the end.
@@ -65,6 +72,9 @@ impl ShootStats {
             queries: 0,
             links: 0,
             leaf_links: 0,
+            held_links: 0,
+            most_held_links: 0,
+            exchanged_bytes: 0,
             initial_unshot_fraction: 0.0,
             unshot_fraction: 0.0,
             cached_shots: 0,

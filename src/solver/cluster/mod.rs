@@ -11,12 +11,15 @@
 //!
 //! Each receiver group is one job: its links, its sweeps' arithmetic and its samples' results
 //! depend on nothing else, and the coordinator applies the groups' results in order, so the
-//! answer is bit-identical for any number of workers.
+//! answer is bit-identical for any number of workers. Spread over ranks (`distributed`), each
+//! rank links and gathers its own groups only, and the groups' results are all-gathered before
+//! the coordinator applies them, in the same order: bit-identical for any number of ranks too.
 
 pub(crate) mod coherence;
 pub(crate) mod links;
 pub(crate) mod sweep;
 pub(crate) mod tree;
+mod wire;
 
 use std::ops::ControlFlow;
 use std::sync::RwLock;
@@ -31,6 +34,7 @@ use super::normalise::row_scale;
 use super::pipeline::with_pool;
 use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
+use crate::distributed::{gather_one, owners, Ranks};
 use crate::error::Result;
 use crate::parallel::for_chunks;
 use crate::progress::Control;
@@ -61,6 +65,10 @@ struct Inputs {
 /// they delivered to its members in the last sweep.
 struct Group {
     root: Ref,
+    /// The rank that holds its links and gathers it (0 in one process).
+    owner: usize,
+    /// Whether that is this rank.
+    owned: bool,
     links: Vec<Links>,
     delivered: Vec<DVec3>,
 }
@@ -102,6 +110,7 @@ pub(crate) fn shoot(
     let tree = Tree::build(samples, &rho, &weight, cx);
     debug_assert_eq!(tree.validate(samples), Ok(()));
     let roots = tree.cut(group_size(n));
+    let ranks = settings.ranks;
     let linker = Linker {
         tree: &tree,
         samples,
@@ -113,16 +122,33 @@ pub(crate) fn shoot(
         seed: settings.seed,
     };
     let (groups, flow) = link_groups(&linker, &roots, settings, &mut stats, report)?;
+    // Each rank gives 3 values a sample of its groups to every sweep's exchange.
+    let mut counts = vec![0usize; ranks.size().max(1)];
+    for g in &groups {
+        counts[g.owner] += 3 * members_of(&tree, g.root);
+    }
     let all = || groups.iter().flat_map(|g| &g.links);
-    stats.links = all().map(|l| (l.leaf.len() + l.cluster.len()) as u64).sum();
+    stats.held_links = all().map(|l| (l.leaf.len() + l.cluster.len()) as u64).sum();
     stats.leaf_links = all().map(|l| l.leaf.len() as u64).sum();
+    stats.links = stats.held_links;
+    stats.most_held_links = stats.held_links;
+    if ranks.size() > 1 {
+        // Counts below 2⁵³ are exact in f64.
+        let held = gather_one(ranks, stats.held_links as f64)?;
+        stats.links = held.iter().sum::<f64>() as u64;
+        stats.most_held_links = held.iter().fold(0.0f64, |a, &b| a.max(b)) as u64;
+        stats.leaf_links = gather_one(ranks, stats.leaf_links as f64)?
+            .iter()
+            .sum::<f64>() as u64;
+        stats.queries = gather_one(ranks, stats.queries as f64)?.iter().sum::<f64>() as u64;
+    }
     let link_bytes: usize = all().map(Links::bytes).sum();
-    if flow.is_break() {
+    if crate::distributed::any(ranks, flow.is_break())? {
         stats.stop = StopReason::Stopped;
         stats.bytes = link_bytes as u64;
         return Ok(stats);
     }
-    let groups = sweep(state, &tree, groups, settings, &mut stats, report)?;
+    let groups = sweep(state, &tree, groups, &counts, settings, &mut stats, report)?;
     let delivered: usize = groups
         .iter()
         .map(|g| g.delivered.capacity() * std::mem::size_of::<DVec3>())
@@ -159,10 +185,16 @@ fn shooter_weights(state: &State) -> (Vec<f64>, f64) {
     (weight, reference)
 }
 
-/// Every receiver group's links: every pair of groups (each group with itself too) is a job
-/// of the pipeline, whose links go to its two groups in job order; then one list per group.
-/// The links count against what the samples leave of the memory budget as they come in. Whether
-/// the host let the linking finish.
+/// Every receiver group's links: every pair of groups (each group with itself too) is a job of
+/// the pipeline, whose links go to its two groups; then one list per group, its parts in job
+/// order. The links count against what the samples leave of the memory budget as they come
+/// in. Whether the host let the linking finish.
+///
+/// Over several ranks, rank r runs every size-th job (pairs near each other in the tree, the
+/// costly ones, are thus spread evenly); the groups then go to the ranks in contiguous runs of
+/// about equal links (the links a group gets say what it costs to hold and to sweep, which its
+/// samples do not: a group in a large open room gets several times the links of one in a
+/// corridor), and each part of a link list is sent to its group's rank (see `wire`).
 fn link_groups(
     linker: &Linker,
     roots: &[Ref],
@@ -171,23 +203,24 @@ fn link_groups(
     report: &mut dyn FnMut(Tick) -> Control,
 ) -> Result<(Vec<Group>, ControlFlow<()>)> {
     let threads = settings.threads.max(1);
-    let mut groups: Vec<Group> = roots
-        .iter()
-        .map(|&root| Group {
-            root,
-            links: Vec::new(),
-            delivered: Vec::new(),
-        })
-        .collect();
+    let ranks = settings.ranks;
+    let (me, size) = (ranks.rank(), ranks.size().max(1));
     let pairs: Vec<(usize, usize)> = (0..roots.len())
         .flat_map(|x| (x..roots.len()).map(move |y| (x, y)))
         .collect();
-    let link = |(x, y): (usize, usize)| linker.links_between(roots[x], roots[y]);
-    let total = pairs.len();
+    let jobs: Vec<usize> = (me..pairs.len()).step_by(size).collect();
+    let link = |job: usize| {
+        let (x, y) = pairs[job];
+        linker.links_between(roots[x], roots[y])
+    };
+    let total = jobs.len();
+    // Per group, the parts found here, with their jobs.
+    let mut parts: Vec<Vec<(u32, Links)>> = vec![Vec::new(); roots.len()];
     // The pipeline holds at most its capacity of jobs' links beyond those counted.
     let mut held = 0usize;
     let flow = with_pool(threads, settings.capacity, &link, |pool| {
-        pool.run(pairs.iter().copied(), |job, (first, second)| {
+        pool.run(jobs.iter().copied(), |i, (first, second)| {
+            let job = jobs[i];
             let (x, y) = pairs[job];
             stats.queries += first.queries + second.queries;
             held += first.bytes() + second.bytes();
@@ -198,19 +231,55 @@ fn link_groups(
                         "the cluster links outgrew what the samples leave of the budget ({} after \
                          {} of {} groups' pairs): raise the budget or the cluster threshold",
                         crate::budget::human_bytes(settings.memory_bytes as f64),
-                        job + 1,
+                        i + 1,
                         total
                     ),
                 ));
             }
             for (group, links) in [(x, first), (y, second)] {
                 if !(links.leaf.is_empty() && links.cluster.is_empty()) {
-                    groups[group].links.push(links);
+                    parts[group].push((job as u32, links));
                 }
             }
-            Ok(flow(report(Tick::linking((job + 1) as f64 / total as f64))))
+            Ok(flow(report(Tick::linking(
+                (i + 1) as f64 / total.max(1) as f64,
+            ))))
         })
     })?;
+    let owner = if size > 1 {
+        let owner = share_groups(ranks, &parts)?;
+        let mut to = vec![Vec::new(); size];
+        for (g, group_parts) in parts.iter_mut().enumerate() {
+            if owner[g] != me {
+                for (job, links) in group_parts.drain(..) {
+                    wire::put(&mut to[owner[g]], job, g, &links);
+                }
+                *group_parts = Vec::new();
+            }
+        }
+        for words in ranks.exchange(&to)? {
+            wire::take(&words, &mut parts)?;
+        }
+        owner
+    } else {
+        vec![0; roots.len()]
+    };
+    let mut groups: Vec<Group> = roots
+        .iter()
+        .zip(owner)
+        .zip(parts)
+        .map(|((&root, owner), mut parts)| {
+            // Job order, as one process finds them: the sums in the sweeps go in that order.
+            parts.sort_by_key(|(job, _)| *job);
+            Group {
+                root,
+                owned: owner == me,
+                owner,
+                links: parts.into_iter().map(|(_, links)| links).collect(),
+                delivered: Vec::new(),
+            }
+        })
+        .collect();
     // One list per group for the sweeps (which run through them many times), joined in
     // parallel.
     for_chunks(&mut groups, 1, threads, |_, group| {
@@ -231,12 +300,35 @@ fn link_groups(
     Ok((groups, flow))
 }
 
+/// The rank of each group: contiguous runs of about equal links, from every rank's counts.
+fn share_groups(ranks: &dyn Ranks, parts: &[Vec<(u32, Links)>]) -> Result<Vec<usize>> {
+    let size = ranks.size().max(1);
+    let n = parts.len();
+    let here: Vec<f64> = parts
+        .iter()
+        .map(|p| {
+            p.iter()
+                .map(|(_, l)| (l.leaf.len() + l.cluster.len()) as f64)
+                .sum()
+        })
+        .collect();
+    let mut all = vec![0.0; n * size];
+    ranks.all_gather(&here, &vec![n; size], &mut all)?;
+    // A group's weight: its links, plus one so that groups without links still spread.
+    let weight: Vec<usize> = (0..n)
+        .map(|g| (0..size).map(|r| all[r * n + g]).sum::<f64>() as usize + 1)
+        .collect();
+    Ok(owners(&weight, size))
+}
+
 /// The row sums (one sweep with unit radiosity, when asked), then sweeps until the unshot
 /// power is below the tolerance, the sweeps run out, or the host stops; the groups back.
+/// `counts`: what each rank gives to a sweep's exchange.
 fn sweep(
     state: &mut State,
     tree: &Tree,
     mut groups: Vec<Group>,
+    counts: &[usize],
     settings: &Settings,
     stats: &mut ShootStats,
     report: &mut dyn FnMut(Tick) -> Control,
@@ -247,7 +339,12 @@ fn sweep(
     // What every group's sweep reads: written by the coordinator between sweeps, read by the
     // workers during them.
     let inputs = RwLock::new(Inputs::default());
+    let ranks = settings.ranks;
     let work = |mut group: Group| -> Result<Group> {
+        if !group.owned {
+            // Another rank's: its deliveries come in the exchange.
+            return Ok(group);
+        }
         let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
         let sources = Sources {
             tree,
@@ -285,14 +382,17 @@ fn sweep(
             let mut kept = Vec::with_capacity(groups.len());
             let mut sums = vec![0.0f64; n];
             pool.run_all(groups.drain(..), |_, group| {
-                let first = first_member(tree, group.root);
-                for (p, h) in group.delivered.iter().enumerate() {
-                    sums[tree.order[first + p] as usize] = h.x;
-                }
                 kept.push(group);
                 Ok(())
             })?;
             groups = kept;
+            stats.exchanged_bytes += exchange(&mut groups, tree, ranks, counts)?;
+            for group in &groups {
+                let first = first_member(tree, group.root);
+                for (p, h) in group.delivered.iter().enumerate() {
+                    sums[tree.order[first + p] as usize] = h.x;
+                }
+            }
             for (i, scale) in state.row_scale.iter_mut().enumerate() {
                 *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
             }
@@ -335,13 +435,13 @@ fn sweep(
                 stats.stop = StopReason::ShotLimit;
                 break;
             }
-            if report(Tick::shooting(
+            let stop = report(Tick::shooting(
                 stats.shots,
                 stats.unshot_fraction,
                 stats.initial_unshot_fraction,
                 settings.tolerance,
-            )) == Control::Stop
-            {
+            )) == Control::Stop;
+            if crate::distributed::any(ranks, stop)? {
                 stats.stop = StopReason::Stopped;
                 break;
             }
@@ -359,14 +459,17 @@ fn sweep(
             let mut delivered = DVec3::ZERO;
             let mut kept = Vec::with_capacity(groups.len());
             pool.run_all(groups.drain(..), |_, group| {
-                let first = first_member(tree, group.root);
-                for (p, &h) in group.delivered.iter().enumerate() {
-                    delivered += h * samples.area[tree.order[first + p] as usize];
-                }
                 kept.push(group);
                 Ok(())
             })?;
             groups = kept;
+            stats.exchanged_bytes += exchange(&mut groups, tree, ranks, counts)?;
+            for group in &groups {
+                let first = first_member(tree, group.root);
+                for (p, &h) in group.delivered.iter().enumerate() {
+                    delivered += h * samples.area[tree.order[first + p] as usize];
+                }
+            }
             let factor = if rows.is_empty() {
                 DVec3::ONE
             } else {
@@ -505,6 +608,39 @@ fn balance(owed: DVec3, delivered: DVec3) -> DVec3 {
         one(owed.y, delivered.y),
         one(owed.z, delivered.z),
     )
+}
+
+/// Every rank's groups' deliveries to every rank (one all-gather of 3 values a sample, in tree
+/// order: each rank's groups are one run of it); bytes received.
+fn exchange(groups: &mut [Group], tree: &Tree, ranks: &dyn Ranks, counts: &[usize]) -> Result<u64> {
+    if ranks.size() <= 1 {
+        return Ok(0);
+    }
+    let mine: Vec<f64> = groups
+        .iter()
+        .filter(|g| g.owned)
+        .flat_map(|g| g.delivered.iter().flat_map(|h| [h.x, h.y, h.z]))
+        .collect();
+    let mut all = vec![0.0; counts.iter().sum()];
+    ranks.all_gather(&mine, counts, &mut all)?;
+    for group in groups.iter_mut().filter(|g| !g.owned) {
+        let first = 3 * first_member(tree, group.root);
+        let values = &all[first..first + 3 * members_of(tree, group.root)];
+        group.delivered.clear();
+        group
+            .delivered
+            .extend(values.chunks_exact(3).map(|v| DVec3::new(v[0], v[1], v[2])));
+    }
+    Ok(((all.len() - mine.len()) * std::mem::size_of::<f64>()) as u64)
+}
+
+/// How many samples `r` stands for.
+fn members_of(tree: &Tree, r: Ref) -> usize {
+    if r.is_leaf() {
+        1
+    } else {
+        tree.nodes[r.index()].count as usize
+    }
 }
 
 fn first_member(tree: &Tree, r: Ref) -> usize {

@@ -44,6 +44,11 @@ impl Ref {
     pub fn raw(self) -> u32 {
         self.0
     }
+
+    /// The reference whose [`raw`](Ref::raw) value this is.
+    pub fn from_raw(raw: u32) -> Ref {
+        Ref(raw)
+    }
 }
 
 /// Side id of nodes whose samples lie on several sides.

@@ -1,0 +1,178 @@
+//! One solve spread over several processes (MPI ranks, say): what the solver needs of the
+//! transport between them, so that the library itself links no MPI.
+//!
+//! Every rank runs the same solve on the same scene and options. What is cheap to repeat or
+//! must be the same everywhere is replicated: the geometry, the visibility structure, the
+//! samples (placed deterministically, so every rank places the same ones), the cluster tree and
+//! the per-sample state. What grows fastest is dealt out: the cluster tree's receiver groups go
+//! to the ranks in contiguous runs of about equal samples, and each rank builds and keeps only
+//! the links into its own groups, so the links held per rank fall about as 1/N. Each sweep
+//! every rank gathers its groups' irradiance and one all-gather gives every rank everyone's
+//! (24 bytes a sample); the rest of the sweep (the balance, the new unshot radiosity, the
+//! specular transfer) is the same arithmetic in the same order on every rank, so the result is
+//! the single-process solve's, bit for bit. See `docs/distributed.md`.
+//!
+//! The CLI implements [`Ranks`] over MPI (its `mpi` feature); a host may implement it over its
+//! own transport. [`Single`] is one process alone, what [`solve`](crate::solve) uses.
+
+use crate::error::{Error, Result};
+
+/// The collective operations a distributed solve needs. Every rank calls them in the same
+/// order with the same `counts`; each call returns on every rank or fails.
+///
+/// A rank that fails between calls leaves the others waiting in the next one: the
+/// implementation (or its host) must end the whole job then (`MPI_Abort`, as the CLI does).
+pub trait Ranks: Sync {
+    /// This process's rank, `0..size()`.
+    fn rank(&self) -> usize;
+    /// How many ranks take part.
+    fn size(&self) -> usize;
+    /// Every rank's `mine` concatenated in rank order into `out`: rank r gives `counts[r]`
+    /// values, and `out.len()` is their sum.
+    fn all_gather(&self, mine: &[f64], counts: &[usize], out: &mut [f64]) -> Result<()>;
+
+    /// Sends `to[r]` to each rank r (`to.len()` is `size()`) and returns what each rank sent
+    /// this one, in rank order. The default goes through [`all_gather`](Ranks::all_gather),
+    /// every rank receiving everything; an implementation over MPI overrides it with one
+    /// `MPI_Alltoallv`.
+    fn exchange(&self, to: &[Vec<u32>]) -> Result<Vec<Vec<u32>>> {
+        let (me, size) = (self.rank(), self.size().max(1));
+        if to.len() != size {
+            return Err(Error::Worker {
+                problem: format!("an exchange for {} ranks among {size}", to.len()),
+            });
+        }
+        // Everyone's lengths first: lengths[r * size + t] is what r sends t.
+        let lengths: Vec<f64> = to.iter().map(|v| v.len() as f64).collect();
+        let mut all = vec![0.0; size * size];
+        self.all_gather(&lengths, &vec![size; size], &mut all)?;
+        let counts: Vec<usize> = (0..size)
+            .map(|r| all[r * size..(r + 1) * size].iter().sum::<f64>() as usize)
+            .collect();
+        let mine: Vec<f64> = to.iter().flatten().map(|&w| f64::from(w)).collect();
+        let mut everything = vec![0.0; counts.iter().sum()];
+        self.all_gather(&mine, &counts, &mut everything)?;
+        let mut from = Vec::with_capacity(size);
+        let mut at = 0;
+        for r in 0..size {
+            let row = &all[r * size..(r + 1) * size];
+            let before: usize = row[..me].iter().sum::<f64>() as usize;
+            let length = row[me] as usize;
+            from.push(
+                everything[at + before..at + before + length]
+                    .iter()
+                    .map(|&w| w as u32)
+                    .collect(),
+            );
+            at += counts[r];
+        }
+        Ok(from)
+    }
+}
+
+/// One process: nothing to exchange.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Single;
+
+impl Ranks for Single {
+    fn rank(&self) -> usize {
+        0
+    }
+
+    fn size(&self) -> usize {
+        1
+    }
+
+    fn all_gather(&self, mine: &[f64], counts: &[usize], out: &mut [f64]) -> Result<()> {
+        check(mine, counts, out, 0)?;
+        out.copy_from_slice(mine);
+        Ok(())
+    }
+
+    fn exchange(&self, to: &[Vec<u32>]) -> Result<Vec<Vec<u32>>> {
+        Ok(to.to_vec())
+    }
+}
+
+/// Checks one all-gather's lengths (`rank` giving `mine`): an implementation calls it first.
+pub fn check(mine: &[f64], counts: &[usize], out: &[f64], rank: usize) -> Result<()> {
+    let total: usize = counts.iter().sum();
+    if counts.get(rank) != Some(&mine.len()) || total != out.len() {
+        return Err(Error::Worker {
+            problem: format!(
+                "an all-gather's lengths disagree on rank {rank}: gives {}, counts {:?}, \
+                 receives {}",
+                mine.len(),
+                counts,
+                out.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Each rank's values gathered: `out[r]` is what rank r gave (one value each).
+pub(crate) fn gather_one(ranks: &dyn Ranks, value: f64) -> Result<Vec<f64>> {
+    let n = ranks.size().max(1);
+    let mut out = vec![0.0; n];
+    ranks.all_gather(&[value], &vec![1; n], &mut out)?;
+    Ok(out)
+}
+
+/// Whether any rank says yes.
+pub(crate) fn any(ranks: &dyn Ranks, yes: bool) -> Result<bool> {
+    if ranks.size() <= 1 {
+        return Ok(yes);
+    }
+    Ok(gather_one(ranks, if yes { 1.0 } else { 0.0 })?
+        .iter()
+        .any(|&v| v != 0.0))
+}
+
+/// The rank that owns each of `groups` receiver groups, given each group's samples: contiguous
+/// runs of about equal samples, a group going to the rank its middle sample falls in. Rank r
+/// owns a run of groups, so its groups' samples are one run of the tree's order.
+pub(crate) fn owners(members: &[usize], size: usize) -> Vec<usize> {
+    let size = size.max(1);
+    let total: usize = members.iter().sum();
+    let mut first = 0usize;
+    members
+        .iter()
+        .map(|&m| {
+            let middle = first + m / 2;
+            first += m;
+            (middle * size)
+                .checked_div(total)
+                .map_or(0, |r| r.min(size - 1))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn owners_are_contiguous_and_balanced() {
+        // Ten groups of 100 samples over three ranks: the middles 50, 150, ... 950 against
+        // thirds of 1000 (333, 667): groups 0-2, 3-6, 7-9.
+        let owner = owners(&[100; 10], 3);
+        assert_eq!(owner, vec![0, 0, 0, 1, 1, 1, 1, 2, 2, 2]);
+        // One rank owns everything; no samples at all is rank 0's.
+        assert_eq!(owners(&[5, 7, 1], 1), vec![0, 0, 0]);
+        assert_eq!(owners(&[0, 0], 4), vec![0, 0]);
+        // A group far larger than the others still goes to one rank (its middle, 501 of
+        // 1002, is in the second half).
+        assert_eq!(owners(&[1, 1000, 1], 2), vec![0, 1, 1]);
+    }
+
+    #[test]
+    fn single_checks_lengths() {
+        let mut out = [0.0; 2];
+        assert!(Single.all_gather(&[1.0, 2.0], &[2], &mut out).is_ok());
+        assert_eq!(out, [1.0, 2.0]);
+        assert!(Single.all_gather(&[1.0], &[2], &mut out).is_err());
+        assert!(any(&Single, true).unwrap());
+        assert!(!any(&Single, false).unwrap());
+    }
+}
