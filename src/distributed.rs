@@ -111,6 +111,28 @@ pub fn check(mine: &[f64], counts: &[usize], out: &[f64], rank: usize) -> Result
     Ok(())
 }
 
+/// A rank's place alone, to work out what another rank gives (its collectives are not used).
+pub(crate) struct Fixed {
+    pub rank: usize,
+    pub size: usize,
+}
+
+impl Ranks for Fixed {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+
+    fn size(&self) -> usize {
+        self.size
+    }
+
+    fn all_gather(&self, _: &[f64], _: &[usize], _: &mut [f64]) -> Result<()> {
+        Err(Error::Worker {
+            problem: "a rank's place was asked to exchange".into(),
+        })
+    }
+}
+
 /// Each rank's values gathered: `out[r]` is what rank r gave (one value each).
 pub(crate) fn gather_one(ranks: &dyn Ranks, value: f64) -> Result<Vec<f64>> {
     let n = ranks.size().max(1);

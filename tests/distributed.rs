@@ -1,4 +1,5 @@
-//! A solve spread over ranks gives one process's solution, bit for bit: ranks simulated by
+//! A solve (and a render) spread over ranks gives one process's solution (and image), bit for
+//! bit: ranks simulated by
 //! threads of this process, exchanging through shared memory (the CLI's MPI ranks are tested
 //! in cli/tests/mpi.rs, with the `mpi` feature). The threads' transport implements only
 //! `all_gather`, so the links also go through `Ranks::exchange`'s default.
@@ -8,7 +9,7 @@ mod common;
 use std::sync::{Arc, Barrier, Mutex};
 
 use meshlight::distributed::{check, Ranks};
-use meshlight::{Control, Options, Scene, Solution};
+use meshlight::{Control, Image, Options, RenderOptions, Scene, Solution};
 
 /// What the simulated ranks share: a slot per rank, and a barrier.
 struct Shared {
@@ -51,13 +52,13 @@ impl Ranks for Threaded {
     }
 }
 
-/// Solves `scene` on `size` simulated ranks; every rank's solution.
+/// Solves and renders `scene` on `size` simulated ranks; every rank's solution and image.
 fn on_ranks(
     scene: &Scene,
     backend: meshlight::Backend,
     options: &Options,
     size: usize,
-) -> Vec<Solution> {
+) -> Vec<(Solution, Image)> {
     let shared = Arc::new(Shared {
         slots: Mutex::new(vec![Vec::new(); size]),
         barrier: Barrier::new(size),
@@ -73,10 +74,28 @@ fn on_ranks(
                 };
                 let vis = vis.as_ref();
                 s.spawn(move || {
-                    meshlight::solver::solve_distributed(scene, vis, options, &ranks, &mut |_| {
-                        Control::Continue
-                    })
-                    .unwrap()
+                    let solution = meshlight::solver::solve_distributed(
+                        scene,
+                        vis,
+                        options,
+                        &ranks,
+                        &mut |_| Control::Continue,
+                    )
+                    .unwrap();
+                    let render = RenderOptions {
+                        threads: 1,
+                        ..RenderOptions::default()
+                    };
+                    let (image, _) = meshlight::render::render_distributed(
+                        scene,
+                        &solution,
+                        vis,
+                        &render,
+                        &ranks,
+                        &mut |_| Control::Continue,
+                    )
+                    .unwrap();
+                    (solution, image)
                 })
             })
             .collect();
@@ -111,10 +130,23 @@ fn check_scene(scene: &Scene, options: &Options) {
                 .unwrap()
         };
         assert!(largest(&one).links > 0);
+        let render = RenderOptions {
+            threads: 2,
+            ..RenderOptions::default()
+        };
+        let (image, _) = meshlight::render(scene, &one, vis.as_ref(), &render, &mut |_| {
+            Control::Continue
+        })
+        .unwrap();
         for size in [2, 3] {
-            let solutions = on_ranks(scene, backend, options, size);
-            for (rank, s) in solutions.iter().enumerate() {
+            let (solutions, images): (Vec<Solution>, Vec<Image>) =
+                on_ranks(scene, backend, options, size).into_iter().unzip();
+            for (rank, (s, i)) in solutions.iter().zip(&images).enumerate() {
                 same(&one, s, &format!("{backend:?}, rank {rank} of {size}"));
+                assert!(
+                    i.pixels == image.pixels,
+                    "{backend:?}, rank {rank} of {size}: the image differs"
+                );
             }
             let sh = largest(&solutions[0]);
             // The ranks hold the links between them, and none holds much more than its share:
@@ -146,7 +178,7 @@ fn check_scene(scene: &Scene, options: &Options) {
 
 #[test]
 fn the_room_on_two_and_three_ranks_is_one_process_solve() {
-    let scene = Scene::load(common::shipped("room")).unwrap();
+    let scene = common::shipped_at("room", 96);
     let options = Options {
         threads: 1,
         ..Options::default()
@@ -156,7 +188,7 @@ fn the_room_on_two_and_three_ranks_is_one_process_solve() {
 
 #[test]
 fn a_reduced_gallery_on_two_and_three_ranks_is_one_process_solve() {
-    let scene = Scene::load(common::shipped("gallery")).unwrap();
+    let scene = common::shipped_at("gallery", 96);
     let options = Options {
         threads: 1,
         epsilon: Some(0.45),

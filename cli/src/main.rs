@@ -218,9 +218,6 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         }
         Method::Meshless => {
             let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
-            if !ranks::root() {
-                return Ok(());
-            }
             let preset = render_options_from(&r.solve.knobs, r.supersample, r.direct_rays)?;
             let render_options = meshlight::RenderOptions {
                 threads: options.threads,
@@ -235,8 +232,18 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
             };
             let t = std::time::Instant::now();
             let (image, stats) = progress::with_progress("render", |progress| {
-                meshlight::render(&scene, &solution, vis.as_ref(), &render_options, progress)
+                meshlight::render::render_distributed(
+                    &scene,
+                    &solution,
+                    vis.as_ref(),
+                    &render_options,
+                    ranks::ranks(),
+                    progress,
+                )
             })?;
+            if !ranks::root() {
+                return Ok(());
+            }
             let summary = solve_summary(&scene, &solution, &options, vis.name())
                 + &render_summary(&image, &stats, t.elapsed().as_secs_f64());
             (image, summary)

@@ -165,6 +165,29 @@ pub fn render(
     options: &RenderOptions,
     progress: Callback,
 ) -> Result<(Image, RenderStats)> {
+    render_distributed(
+        scene,
+        solution,
+        vis,
+        options,
+        &crate::distributed::Single,
+        progress,
+    )
+}
+
+/// [`render`] spread over `ranks` (each with the same solution, as
+/// [`solve_distributed`](crate::solver::solve_distributed) leaves it): each rank shades a run
+/// of the image's rows, then a run of its edge pixels, and every rank gets the whole image,
+/// equal to one process's bit for bit (every ray's value depends only on its pixel and id).
+/// A Stop on any rank stops all at the end of a pass.
+pub fn render_distributed(
+    scene: &Scene,
+    solution: &Solution,
+    vis: &dyn Visibility,
+    options: &RenderOptions,
+    ranks: &dyn crate::distributed::Ranks,
+    progress: Callback,
+) -> Result<(Image, RenderStats)> {
     crate::parallel::guarded("rendering", || {
         let checked = crate::visibility::Checked::new(vis, scene);
         let vis: &dyn crate::visibility::Visibility = &checked;
@@ -228,13 +251,33 @@ pub fn render(
             );
             Ok(())
         };
+        let mine = ranks_share(ranks, centre.len(), w * 4);
         let all = !reporter.stopped()
-            && for_chunks_reporting(&mut centre, w * 4, options.threads, trace, &mut |f| {
-                control(reporter.report(Progress {
-                    fraction: CENTRE_SHARE * f,
-                    ..base
-                }))
-            })?;
+            && for_chunks_reporting(
+                &mut centre[mine.clone()],
+                w * 4,
+                options.threads,
+                |first, out| trace(mine.start + first, out),
+                &mut |f| {
+                    control(reporter.report(Progress {
+                        fraction: CENTRE_SHARE * f,
+                        ..base
+                    }))
+                },
+            )?;
+        let all = !crate::distributed::any(ranks, !all)?;
+        gather_share(
+            ranks,
+            &mut centre,
+            w * 4,
+            |c| [c.0.x, c.0.y, c.0.z, c.1 as f32].map(f64::from),
+            |v| {
+                (
+                    Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32),
+                    v[3] as u32,
+                )
+            },
+        )?;
         stats.camera_rays = (w * h) as u64;
 
         // Edge pixels, refined with more rays.
@@ -251,17 +294,35 @@ pub fn render(
             );
             Ok(())
         };
+        let mine = ranks_share(ranks, refined.len(), 64);
         let all = all
-            && for_chunks_reporting(&mut refined, 64, options.threads, refine, &mut |f| {
-                control(reporter.report(Progress {
-                    fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,
-                    ..base
-                }))
-            })?;
+            && for_chunks_reporting(
+                &mut refined[mine.clone()],
+                64,
+                options.threads,
+                |first, out| refine(mine.start + first, out),
+                &mut |f| {
+                    control(reporter.report(Progress {
+                        fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,
+                        ..base
+                    }))
+                },
+            )?;
+        let all = !crate::distributed::any(ranks, !all)?;
+        gather_share(
+            ranks,
+            &mut refined,
+            64,
+            |r| match r {
+                Some(v) => [1.0, f64::from(v.x), f64::from(v.y), f64::from(v.z)],
+                None => [0.0; 4],
+            },
+            |v| (v[0] != 0.0).then(|| Vec3::new(v[1] as f32, v[2] as f32, v[3] as f32)),
+        )?;
         stats.camera_rays += (edges.first_ray.last().copied().unwrap_or(w * h) - w * h) as u64;
         stats.supersampled_pixels = refined.iter().filter(|r| r.is_some()).count() as u64;
-        stats.interpolation_queries = queries.into_inner();
-        stats.shadow_rays = shader.shadow_rays.into_inner();
+        stats.interpolation_queries = sum_over(ranks, queries.into_inner())?;
+        stats.shadow_rays = sum_over(ranks, shader.shadow_rays.into_inner())?;
         stats.stopped = !all;
 
         let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
@@ -279,6 +340,63 @@ pub fn render(
             stats,
         ))
     })
+}
+
+/// This rank's run of `len` items cut in chunks of `chunk`: whole chunks, so that each rank
+/// cuts its run where one process would.
+fn ranks_share(
+    ranks: &dyn crate::distributed::Ranks,
+    len: usize,
+    chunk: usize,
+) -> std::ops::Range<usize> {
+    let (rank, size) = (ranks.rank(), ranks.size().max(1));
+    let chunks = len.div_ceil(chunk.max(1));
+    let edge = |r: usize| (r * chunks / size * chunk).min(len);
+    edge(rank)..edge(rank + 1)
+}
+
+/// Every rank's run of `out` (see [`ranks_share`]) to every rank, as four numbers an item.
+fn gather_share<T>(
+    ranks: &dyn crate::distributed::Ranks,
+    out: &mut [T],
+    chunk: usize,
+    put: impl Fn(&T) -> [f64; 4],
+    take: impl Fn(&[f64]) -> T,
+) -> Result<()> {
+    let size = ranks.size().max(1);
+    if size == 1 {
+        return Ok(());
+    }
+    let counts: Vec<usize> = (0..size)
+        .map(|r| {
+            let share = ranks_share(
+                &crate::distributed::Fixed { rank: r, size },
+                out.len(),
+                chunk,
+            );
+            4 * share.len()
+        })
+        .collect();
+    let mine: Vec<f64> = out[ranks_share(ranks, out.len(), chunk)]
+        .iter()
+        .flat_map(&put)
+        .collect();
+    let mut all = vec![0.0; 4 * out.len()];
+    ranks.all_gather(&mine, &counts, &mut all)?;
+    for (item, values) in out.iter_mut().zip(all.chunks_exact(4)) {
+        *item = take(values);
+    }
+    Ok(())
+}
+
+/// A count summed over the ranks.
+fn sum_over(ranks: &dyn crate::distributed::Ranks, count: u64) -> Result<u64> {
+    if ranks.size() <= 1 {
+        return Ok(count);
+    }
+    Ok(crate::distributed::gather_one(ranks, count as f64)?
+        .iter()
+        .sum::<f64>() as u64)
 }
 
 fn control(stop: bool) -> Control {
