@@ -141,6 +141,18 @@ pub(crate) fn gather_one(ranks: &dyn Ranks, value: f64) -> Result<Vec<f64>> {
     Ok(out)
 }
 
+/// Every rank's `mine` (32-bit words) concatenated in rank order, on every rank.
+pub(crate) fn all_gather_words(ranks: &dyn Ranks, mine: &[u32]) -> Result<Vec<u32>> {
+    let counts: Vec<usize> = gather_one(ranks, mine.len() as f64)?
+        .iter()
+        .map(|&c| c as usize)
+        .collect();
+    let values: Vec<f64> = mine.iter().map(|&w| f64::from(w)).collect();
+    let mut out = vec![0.0; counts.iter().sum()];
+    ranks.all_gather(&values, &counts, &mut out)?;
+    Ok(out.iter().map(|&v| v as u32).collect())
+}
+
 /// Whether any rank says yes.
 pub(crate) fn any(ranks: &dyn Ranks, yes: bool) -> Result<bool> {
     if ranks.size() <= 1 {

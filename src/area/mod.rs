@@ -35,8 +35,8 @@ pub struct AreaStats {
     pub queries: u64,
 }
 
-/// Computes every sample's area `S`, on up to `threads` threads (the result does not depend
-/// on their number). With `changed` (per side), only the sides it marks are recomputed: the
+/// Computes every sample's area `S`, on up to `threads` threads and over `ranks` (the result
+/// depends on neither: the first pass's runs are dealt to the ranks and all-gathered). With `changed` (per side), only the sides it marks are recomputed: the
 /// others keep the cells and shares the last computation gave them (their samples and radii
 /// must not have changed since). `report` hears the share of cells done now and then; if it
 /// answers Stop, the cells not split yet go whole to their nearest sample, so every side's
@@ -49,7 +49,7 @@ pub(crate) fn compute(
     obstruction: &Obstruction,
     vis: &dyn Visibility,
     (epsilon, alpha): (f32, f32),
-    threads: usize,
+    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
     changed: Option<&[bool]>,
     report: Report,
 ) -> Result<AreaStats> {
@@ -72,7 +72,7 @@ pub(crate) fn compute(
         vis,
         alpha,
     };
-    let runs = split::Splitter::new(samples, reads).count(&layout, threads, report)?;
+    let runs = split::Splitter::new(samples, reads).count(&layout, threads, ranks, report)?;
     for run in &runs {
         stats.queries += run.queries;
         stats.orphan_cells += run.orphans;

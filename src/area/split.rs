@@ -13,6 +13,7 @@
 use glam::Vec2;
 
 use super::{Laid, Layout};
+use crate::distributed::Ranks;
 use crate::error::{Error, Result};
 use crate::parallel::{for_chunks, for_chunks_reporting, Report};
 use crate::sampling::shares::{Writer, WHOLE};
@@ -92,6 +93,67 @@ pub(super) struct Run {
     pub queries: u64,
 }
 
+fn broken() -> Error {
+    Error::Worker {
+        problem: "a rank sent area runs that do not read back (a transport error)".into(),
+    }
+}
+
+impl Run {
+    /// Appends run `r` as words: r, done, orphans, queries (2 words), its slots (3 words each),
+    /// its answers (their count, then 2 words per 64).
+    fn put(&self, r: u32, out: &mut Vec<u32>) {
+        let split = |x: u64| [x as u32, (x >> 32) as u32];
+        out.extend([r, u32::from(self.done), self.orphans as u32]);
+        out.extend(split(self.queries));
+        out.push(self.slots.len() as u32);
+        for s in &self.slots {
+            out.extend([s.sample, s.next, s.prev]);
+        }
+        out.extend(split(self.seen.len as u64));
+        for &w in &self.seen.words {
+            out.extend(split(w));
+        }
+    }
+
+    /// Reads one run written by [`Run::put`] at `*at`, moving past it.
+    fn take(words: &[u32], at: &mut usize) -> Result<(usize, Run)> {
+        let mut next = |n: usize| -> Result<&[u32]> {
+            let w = words.get(*at..*at + n).ok_or_else(broken)?;
+            *at += n;
+            Ok(w)
+        };
+        let join = |w: &[u32]| u64::from(w[0]) | u64::from(w[1]) << 32;
+        let head = next(6)?;
+        let (r, done, orphans) = (head[0] as usize, head[1] != 0, head[2] as usize);
+        let queries = join(&head[3..5]);
+        let slots = head[5] as usize;
+        let slots = next(3 * slots)?
+            .chunks_exact(3)
+            .map(|w| Slot {
+                sample: w[0],
+                next: w[1],
+                prev: w[2],
+            })
+            .collect();
+        let len = join(next(2)?) as usize;
+        let words = next(2 * len.div_ceil(64))?
+            .chunks_exact(2)
+            .map(join)
+            .collect();
+        Ok((
+            r,
+            Run {
+                done,
+                slots,
+                seen: Bits { words, len },
+                orphans,
+                queries,
+            },
+        ))
+    }
+}
+
 /// A growable bit list.
 #[derive(Clone, Debug, Default)]
 struct Bits {
@@ -140,10 +202,22 @@ impl Splitter<'_> {
     /// The first pass: each run's shares per sample and visibility answers. Reports progress;
     /// after a Stop the runs not done are marked so, and [`Splitter::fill`] gives their cells
     /// whole to the nearest sample.
-    pub fn count(&self, layout: &Layout, threads: usize, report: Report) -> Result<Vec<Run>> {
+    ///
+    /// Over several ranks, rank r counts every size-th run, and the runs are all-gathered.
+    pub fn count(
+        &self,
+        layout: &Layout,
+        threads: usize,
+        ranks: &dyn Ranks,
+        report: Report,
+    ) -> Result<Vec<Run>> {
         let cells = &layout.cells;
-        let mut runs = vec![Run::default(); cells.len().div_ceil(RUN)];
-        let count = |r: usize, out: &mut [Run]| {
+        let (rank, size) = (ranks.rank(), ranks.size().max(1));
+        let all = cells.len().div_ceil(RUN);
+        let mine: Vec<usize> = (rank..all).step_by(size).collect();
+        let mut runs = vec![Run::default(); mine.len()];
+        let count = |i: usize, out: &mut [Run]| {
+            let r = mine[i];
             let run = &mut out[0];
             let mut scratch = Scratch::default();
             let mut samples = Vec::new();
@@ -175,7 +249,8 @@ impl Splitter<'_> {
             Ok(())
         };
         if !for_chunks_reporting(&mut runs, 1, threads, count, report)? {
-            for (r, run) in runs.iter_mut().enumerate().filter(|(_, run)| !run.done) {
+            for (i, run) in runs.iter_mut().enumerate().filter(|(_, run)| !run.done) {
+                let r = mine[i];
                 let nearest = (r * RUN..((r + 1) * RUN).min(cells.len()))
                     .filter(|&id| cells[id].is_new())
                     .filter_map(|id| {
@@ -185,7 +260,22 @@ impl Splitter<'_> {
                 run.slots = tally(nearest.collect());
             }
         }
-        Ok(runs)
+        if size == 1 {
+            return Ok(runs);
+        }
+        let mut words = Vec::new();
+        for (i, run) in runs.iter().enumerate() {
+            run.put(mine[i] as u32, &mut words);
+        }
+        drop(runs);
+        let words = crate::distributed::all_gather_words(ranks, &words)?;
+        let mut every = vec![Run::default(); all];
+        let mut at = 0;
+        while at < words.len() {
+            let (r, run) = Run::take(&words, &mut at)?;
+            *every.get_mut(r).ok_or_else(broken)? = run;
+        }
+        Ok(every)
     }
 
     /// The second pass: every run's shares written into the slots `place` gave its samples.
@@ -408,4 +498,58 @@ pub(super) fn place(runs: &mut [Run], next: &mut [u32], last: &mut [u32]) {
 pub(super) fn counts(runs: &[Run]) -> impl Iterator<Item = (u32, u32)> + '_ {
     runs.iter()
         .flat_map(|r| r.slots.iter().map(|s| (s.sample, s.next)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_read_back_as_written() {
+        let mut seen = Bits::default();
+        // 70 answers: two words, the second partly used.
+        for i in 0..70 {
+            seen.push(i % 3 == 0);
+        }
+        let run = Run {
+            done: true,
+            slots: vec![
+                Slot {
+                    sample: 4,
+                    next: 2,
+                    prev: 17,
+                },
+                Slot {
+                    sample: 9,
+                    next: 1,
+                    prev: NONE,
+                },
+            ],
+            seen,
+            orphans: 3,
+            queries: (1 << 40) + 5,
+        };
+        let mut words = Vec::new();
+        run.put(7, &mut words);
+        Run::default().put(8, &mut words);
+        // 6 head words, 3 a slot, 2 for the count of answers and 2 per 64 of them.
+        assert_eq!(words.len(), (6 + 6 + 2 + 4) + (6 + 2));
+        let mut at = 0;
+        let (r, back) = Run::take(&words, &mut at).unwrap();
+        assert_eq!(r, 7);
+        assert!(back.done);
+        assert_eq!((back.orphans, back.queries), (3, (1 << 40) + 5));
+        assert_eq!(back.slots.len(), 2);
+        assert_eq!(
+            (back.slots[1].sample, back.slots[1].next, back.slots[1].prev),
+            (9, 1, NONE)
+        );
+        assert_eq!(back.seen.len, 70);
+        assert!((0..70).all(|i| back.seen.get(i) == (i % 3 == 0)));
+        let (r, empty) = Run::take(&words, &mut at).unwrap();
+        assert_eq!((r, empty.done, empty.slots.len()), (8, false, 0));
+        assert_eq!(at, words.len());
+        // Cut short: an error, not a panic.
+        assert!(Run::take(&words[..5], &mut 0).is_err());
+    }
 }

@@ -184,7 +184,7 @@ impl Solve<'_> {
             &solution.obstruction,
             self.vis,
             (self.epsilon, self.options.alpha),
-            self.options.threads.max(1),
+            (self.options.threads.max(1), self.ranks),
             added.changed.as_deref(),
             &mut self.reporter.part(base),
         )?;
