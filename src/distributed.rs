@@ -31,6 +31,19 @@ pub trait Ranks: Sync {
     /// values, and `out.len()` is their sum.
     fn all_gather(&self, mine: &[f64], counts: &[usize], out: &mut [f64]) -> Result<()>;
 
+    /// [`all_gather`](Ranks::all_gather) for 32-bit words (shares, link lists). The default
+    /// carries each word as an f64 (exact); an implementation over MPI overrides it to move
+    /// 4 bytes a word, not 8.
+    fn all_gather_words(&self, mine: &[u32], counts: &[usize], out: &mut [u32]) -> Result<()> {
+        let values: Vec<f64> = mine.iter().map(|&w| f64::from(w)).collect();
+        let mut all = vec![0.0; out.len()];
+        self.all_gather(&values, counts, &mut all)?;
+        for (o, v) in out.iter_mut().zip(all) {
+            *o = v as u32;
+        }
+        Ok(())
+    }
+
     /// Sends `to[r]` to each rank r (`to.len()` is `size()`) and returns what each rank sent
     /// this one, in rank order. The default goes through [`all_gather`](Ranks::all_gather),
     /// every rank receiving everything; an implementation over MPI overrides it with one
@@ -84,7 +97,7 @@ impl Ranks for Single {
     }
 
     fn all_gather(&self, mine: &[f64], counts: &[usize], out: &mut [f64]) -> Result<()> {
-        check(mine, counts, out, 0)?;
+        check(mine.len(), counts, out.len(), 0)?;
         out.copy_from_slice(mine);
         Ok(())
     }
@@ -94,17 +107,16 @@ impl Ranks for Single {
     }
 }
 
-/// Checks one all-gather's lengths (`rank` giving `mine`): an implementation calls it first.
-pub fn check(mine: &[f64], counts: &[usize], out: &[f64], rank: usize) -> Result<()> {
+/// Checks one all-gather's lengths (`rank` giving `mine` values into `out`): an implementation
+/// calls it first.
+pub fn check(mine: usize, counts: &[usize], out: usize, rank: usize) -> Result<()> {
     let total: usize = counts.iter().sum();
-    if counts.get(rank) != Some(&mine.len()) || total != out.len() {
+    if counts.get(rank) != Some(&mine) || total != out {
         return Err(Error::Worker {
             problem: format!(
                 "an all-gather's lengths disagree on rank {rank}: gives {}, counts {:?}, \
                  receives {}",
-                mine.len(),
-                counts,
-                out.len()
+                mine, counts, out
             ),
         });
     }
@@ -141,16 +153,16 @@ pub(crate) fn gather_one(ranks: &dyn Ranks, value: f64) -> Result<Vec<f64>> {
     Ok(out)
 }
 
-/// Every rank's `mine` (32-bit words) concatenated in rank order, on every rank.
-pub(crate) fn all_gather_words(ranks: &dyn Ranks, mine: &[u32]) -> Result<Vec<u32>> {
+/// Every rank's `mine` (32-bit words) concatenated in rank order, on every rank, with what
+/// each rank gave.
+pub(crate) fn all_gather_words(ranks: &dyn Ranks, mine: &[u32]) -> Result<(Vec<u32>, Vec<usize>)> {
     let counts: Vec<usize> = gather_one(ranks, mine.len() as f64)?
         .iter()
         .map(|&c| c as usize)
         .collect();
-    let values: Vec<f64> = mine.iter().map(|&w| f64::from(w)).collect();
-    let mut out = vec![0.0; counts.iter().sum()];
-    ranks.all_gather(&values, &counts, &mut out)?;
-    Ok(out.iter().map(|&v| v as u32).collect())
+    let mut out = vec![0; counts.iter().sum()];
+    ranks.all_gather_words(mine, &counts, &mut out)?;
+    Ok((out, counts))
 }
 
 /// Whether any rank says yes.

@@ -136,6 +136,25 @@ mod mpi_ranks {
     // SAFETY: as above; the handle is a process-wide communicator, not tied to a thread.
     unsafe impl Send for Mpi {}
 
+    /// MPI's counts and displacements for `counts`, which must fit its 32-bit integers.
+    fn partition(counts: &[usize]) -> meshlight::Result<(Vec<i32>, Vec<i32>)> {
+        let too_many = || Error::Worker {
+            problem: format!(
+                "an exchange of {} values is beyond MPI's 32-bit counts",
+                counts.iter().sum::<usize>()
+            ),
+        };
+        let mut displs = Vec::with_capacity(counts.len());
+        let mut sizes = Vec::with_capacity(counts.len());
+        let mut at = 0usize;
+        for &c in counts {
+            displs.push(i32::try_from(at).map_err(|_| too_many())?);
+            sizes.push(i32::try_from(c).map_err(|_| too_many())?);
+            at += c;
+        }
+        Ok((sizes, displs))
+    }
+
     impl Ranks for Mpi {
         fn rank(&self) -> usize {
             self.world.rank() as usize
@@ -151,21 +170,21 @@ mod mpi_ranks {
             counts: &[usize],
             out: &mut [f64],
         ) -> meshlight::Result<()> {
-            check(mine, counts, out, self.rank())?;
-            let too_many = || Error::Worker {
-                problem: format!(
-                    "an exchange of {} values is beyond MPI's 32-bit counts",
-                    out.len()
-                ),
-            };
-            let mut displs = Vec::with_capacity(counts.len());
-            let mut sizes = Vec::with_capacity(counts.len());
-            let mut at = 0usize;
-            for &c in counts {
-                displs.push(i32::try_from(at).map_err(|_| too_many())?);
-                sizes.push(i32::try_from(c).map_err(|_| too_many())?);
-                at += c;
-            }
+            check(mine.len(), counts, out.len(), self.rank())?;
+            let (sizes, displs) = partition(counts)?;
+            let mut partition = PartitionMut::new(out, sizes, displs);
+            self.world.all_gather_varcount_into(mine, &mut partition);
+            Ok(())
+        }
+
+        fn all_gather_words(
+            &self,
+            mine: &[u32],
+            counts: &[usize],
+            out: &mut [u32],
+        ) -> meshlight::Result<()> {
+            check(mine.len(), counts, out.len(), self.rank())?;
+            let (sizes, displs) = partition(counts)?;
             let mut partition = PartitionMut::new(out, sizes, displs);
             self.world.all_gather_varcount_into(mine, &mut partition);
             Ok(())

@@ -77,7 +77,7 @@ pub(crate) fn compute(
         stats.queries += run.queries;
         stats.orphan_cells += run.orphans;
     }
-    gather_shares(samples, reads, layout, runs, &redo, threads)?;
+    gather_shares(samples, reads, layout, runs, &redo, (threads, ranks))?;
     region_centroids(samples, threads)?;
     Ok(stats)
 }
@@ -219,7 +219,7 @@ fn gather_shares(
     layout: Layout,
     mut runs: Vec<split::Run>,
     redo: &dyn Fn(usize) -> bool,
-    threads: usize,
+    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
 ) -> Result<()> {
     let maps = reads.maps;
     let n = samples.len();
@@ -263,7 +263,7 @@ fn gather_shares(
     }
     split::place(&mut runs, &mut next, &mut last);
     drop((next, last));
-    split::Splitter::new(samples, reads).fill(&layout, &mut runs, threads, &writer)?;
+    split::Splitter::new(samples, reads).fill(&layout, &mut runs, threads, &writer, ranks)?;
     drop(runs);
     samples.shares = writer.finish();
 

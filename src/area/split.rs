@@ -91,6 +91,8 @@ pub(super) struct Run {
     pub orphans: usize,
     /// Visibility queries made.
     pub queries: u64,
+    /// What filling it wrote, for the other ranks ([`sent`]).
+    sent: Vec<u32>,
 }
 
 fn broken() -> Error {
@@ -101,8 +103,12 @@ fn broken() -> Error {
 
 impl Run {
     /// Appends run `r` as words: r, done, orphans, queries (2 words), its slots (3 words each),
-    /// its answers (their count, then 2 words per 64).
+    /// and, for the tests, its answers (their count, then 2 words per 64; none are sent).
     fn put(&self, r: u32, out: &mut Vec<u32>) {
+        self.put_with(r, out, false);
+    }
+
+    fn put_with(&self, r: u32, out: &mut Vec<u32>, answers: bool) {
         let split = |x: u64| [x as u32, (x >> 32) as u32];
         out.extend([r, u32::from(self.done), self.orphans as u32]);
         out.extend(split(self.queries));
@@ -110,9 +116,13 @@ impl Run {
         for s in &self.slots {
             out.extend([s.sample, s.next, s.prev]);
         }
-        out.extend(split(self.seen.len as u64));
-        for &w in &self.seen.words {
-            out.extend(split(w));
+        if answers {
+            out.extend(split(self.seen.len as u64));
+            for &w in &self.seen.words {
+                out.extend(split(w));
+            }
+        } else {
+            out.extend([0, 0]);
         }
     }
 
@@ -149,9 +159,68 @@ impl Run {
                 seen: Bits { words, len },
                 orphans,
                 queries,
+                sent: Vec::new(),
             },
         ))
     }
+}
+
+/// A filled run's shares as words, for the other ranks: per slot its sample, first position,
+/// count, whether it holds the sample's first share and the base cell then, and a word per
+/// share ([`Writer::word`]); then the shares whose steps are too long, as (position, cell).
+fn sent(run: &Run, begin: &[(u32, bool)], writer: &Writer) -> Vec<u32> {
+    let mut out = Vec::new();
+    let mut far = Vec::new();
+    out.push(run.slots.len() as u32);
+    for (slot, &(start, first)) in run.slots.iter().zip(begin) {
+        let count = slot.next - start;
+        let k = slot.sample;
+        out.extend([k, start, count, u32::from(first), writer.base(k as usize)]);
+        for at in start..slot.next {
+            let (word, cell) = writer.word(at as usize);
+            out.push(word);
+            if let Some(cell) = cell {
+                far.extend([at, cell]);
+            }
+        }
+    }
+    out.push((far.len() / 2) as u32);
+    out.extend(far);
+    out
+}
+
+/// Writes what another rank [`sent`].
+fn receive(words: &[u32], writer: &Writer) -> Result<()> {
+    let mut at = 0;
+    let next = |at: &mut usize, n: usize| -> Result<&[u32]> {
+        let w = words.get(*at..*at + n).ok_or_else(broken)?;
+        *at += n;
+        Ok(w)
+    };
+    while at < words.len() {
+        let slots = next(&mut at, 1)?[0];
+        for _ in 0..slots {
+            let head = next(&mut at, 5)?;
+            let (k, start, count, first, base) = (head[0], head[1], head[2], head[3], head[4]);
+            if first != 0 && !writer.set_base(k as usize, base) {
+                return Err(broken());
+            }
+            for (i, &word) in next(&mut at, count as usize)?.iter().enumerate() {
+                if !writer.put(start as usize + i, word, None) {
+                    return Err(broken());
+                }
+            }
+        }
+        let far = next(&mut at, 1)?[0] as usize;
+        for pair in next(&mut at, 2 * far)?.chunks_exact(2) {
+            let (slot, cell) = (pair[0] as usize, pair[1]);
+            let (word, _) = writer.word(slot);
+            if !writer.put(slot, word, Some(cell)) {
+                return Err(broken());
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A growable bit list.
@@ -263,78 +332,124 @@ impl Splitter<'_> {
         if size == 1 {
             return Ok(runs);
         }
+        // The others need each run's slots, not its answers: a run is filled where it was
+        // counted.
         let mut words = Vec::new();
         for (i, run) in runs.iter().enumerate() {
             run.put(mine[i] as u32, &mut words);
         }
-        drop(runs);
-        let words = crate::distributed::all_gather_words(ranks, &words)?;
+        let (words, _) = crate::distributed::all_gather_words(ranks, &words)?;
         let mut every = vec![Run::default(); all];
+        for (i, run) in runs.into_iter().enumerate() {
+            every[mine[i]] = run;
+        }
         let mut at = 0;
         while at < words.len() {
             let (r, run) = Run::take(&words, &mut at)?;
-            *every.get_mut(r).ok_or_else(broken)? = run;
+            if r % size != rank {
+                *every.get_mut(r).ok_or_else(broken)? = run;
+            }
         }
         Ok(every)
     }
 
     /// The second pass: every run's shares written into the slots `place` gave its samples.
+    ///
+    /// Over several ranks, each rank fills the runs it counted (it holds their answers) and
+    /// the filled slots are all-gathered (see [`sent`]).
     pub fn fill(
         &self,
         layout: &Layout,
         runs: &mut [Run],
         threads: usize,
         writer: &Writer,
+        ranks: &dyn Ranks,
     ) -> Result<()> {
-        let cells = &layout.cells;
+        let (rank, size) = (ranks.rank(), ranks.size().max(1));
         let fill = |r: usize, out: &mut [Run]| {
-            let run = &mut out[0];
-            let mut write = |k: u32, id: usize, units: u16| -> Result<()> {
-                let written = match run.slots.binary_search_by_key(&k, |s| s.sample) {
-                    Ok(i) => {
-                        let slot = &mut run.slots[i];
-                        let previous = (slot.prev != NONE).then_some(slot.prev);
-                        let at = slot.next as usize;
-                        slot.next += 1;
-                        slot.prev = id as u32;
-                        writer.write(at, k as usize, previous, id as u32, units)
-                    }
-                    Err(_) => false,
-                };
-                if written {
-                    Ok(())
-                } else {
-                    Err(Error::Worker {
-                        problem: format!(
-                            "splitting area cell {id}: sample {k} was not counted (the \
-                             visibility backend answered differently)"
-                        ),
-                    })
-                }
-            };
-            let ids = r * RUN..((r + 1) * RUN).min(cells.len());
-            if !run.done {
-                for id in ids.filter(|&id| cells[id].is_new()) {
-                    if let Some(k) = self.nearest(layout.side_of(id), cells[id].centroid) {
-                        write(k, id, WHOLE)?;
-                    }
-                }
+            if r % size != rank {
                 return Ok(());
             }
-            let seen = std::mem::take(&mut run.seen);
-            let mut answers = Answers::Replay { seen: &seen, at: 0 };
-            let mut scratch = Scratch::default();
-            for id in ids.filter(|&id| cells[id].is_new()) {
-                self.of_cell(layout.side_of(id), &cells[id], &mut answers, &mut scratch)?;
-                for (&(k, _), &u) in scratch.near.iter().zip(&scratch.units) {
-                    if u > 0 {
-                        write(k, id, u)?;
-                    }
-                }
+            let run = &mut out[0];
+            // Where each slot starts, and whether it holds its sample's first share.
+            let begin: Vec<(u32, bool)> = if size > 1 {
+                run.slots.iter().map(|s| (s.next, s.prev == NONE)).collect()
+            } else {
+                Vec::new()
+            };
+            self.fill_run(layout, r, run, writer)?;
+            if size > 1 {
+                run.sent = sent(run, &begin, writer);
             }
             Ok(())
         };
-        for_chunks(runs, 1, threads, fill)
+        for_chunks(runs, 1, threads, fill)?;
+        if size == 1 {
+            return Ok(());
+        }
+        let mine: Vec<u32> = runs
+            .iter_mut()
+            .flat_map(|r| std::mem::take(&mut r.sent))
+            .collect();
+        let (words, counts) = crate::distributed::all_gather_words(ranks, &mine)?;
+        drop(mine);
+        let mut at = 0;
+        for (r, &count) in counts.iter().enumerate() {
+            if r != rank {
+                receive(&words[at..at + count], writer)?;
+            }
+            at += count;
+        }
+        Ok(())
+    }
+
+    /// Fills run `r`.
+    fn fill_run(&self, layout: &Layout, r: usize, run: &mut Run, writer: &Writer) -> Result<()> {
+        let cells = &layout.cells;
+        let mut write = |k: u32, id: usize, units: u16| -> Result<()> {
+            let written = match run.slots.binary_search_by_key(&k, |s| s.sample) {
+                Ok(i) => {
+                    let slot = &mut run.slots[i];
+                    let previous = (slot.prev != NONE).then_some(slot.prev);
+                    let at = slot.next as usize;
+                    slot.next += 1;
+                    slot.prev = id as u32;
+                    writer.write(at, k as usize, previous, id as u32, units)
+                }
+                Err(_) => false,
+            };
+            if written {
+                Ok(())
+            } else {
+                Err(Error::Worker {
+                    problem: format!(
+                        "splitting area cell {id}: sample {k} was not counted (the \
+                         visibility backend answered differently)"
+                    ),
+                })
+            }
+        };
+        let ids = r * RUN..((r + 1) * RUN).min(cells.len());
+        if !run.done {
+            for id in ids.filter(|&id| cells[id].is_new()) {
+                if let Some(k) = self.nearest(layout.side_of(id), cells[id].centroid) {
+                    write(k, id, WHOLE)?;
+                }
+            }
+            return Ok(());
+        }
+        let seen = std::mem::take(&mut run.seen);
+        let mut answers = Answers::Replay { seen: &seen, at: 0 };
+        let mut scratch = Scratch::default();
+        for id in ids.filter(|&id| cells[id].is_new()) {
+            self.of_cell(layout.side_of(id), &cells[id], &mut answers, &mut scratch)?;
+            for (&(k, _), &u) in scratch.near.iter().zip(&scratch.units) {
+                if u > 0 {
+                    write(k, id, u)?;
+                }
+            }
+        }
+        Ok(())
     }
 
     fn nearest(&self, side: Side, centroid: Vec2) -> Option<u32> {
@@ -528,9 +643,10 @@ mod tests {
             seen,
             orphans: 3,
             queries: (1 << 40) + 5,
+            sent: Vec::new(),
         };
         let mut words = Vec::new();
-        run.put(7, &mut words);
+        run.put_with(7, &mut words, true);
         Run::default().put(8, &mut words);
         // 6 head words, 3 a slot, 2 for the count of answers and 2 per 64 of them.
         assert_eq!(words.len(), (6 + 6 + 2 + 4) + (6 + 2));
@@ -551,5 +667,49 @@ mod tests {
         assert_eq!(at, words.len());
         // Cut short: an error, not a panic.
         assert!(Run::take(&words[..5], &mut 0).is_err());
+    }
+}
+
+#[cfg(test)]
+mod sent_tests {
+    use super::*;
+
+    #[test]
+    fn filled_slots_sent_and_received_write_the_same_shares() {
+        // Sample 0: shares at 0..3 (first share here, one step too long for 16 bits);
+        // sample 1: shares at 3..5, its first share written by an earlier run.
+        let start = vec![0, 3, 5];
+        let here = Writer::new(start.clone());
+        assert!(here.write(0, 0, None, 10, 100));
+        assert!(here.write(1, 0, Some(10), 11, 200));
+        assert!(here.write(2, 0, Some(11), 90_000, 300));
+        assert!(here.write(3, 1, Some(4), 5, 400));
+        assert!(here.write(4, 1, Some(5), 6, 500));
+        let run = Run {
+            slots: vec![
+                Slot {
+                    sample: 0,
+                    next: 3,
+                    prev: 90_000,
+                },
+                Slot {
+                    sample: 1,
+                    next: 5,
+                    prev: 6,
+                },
+            ],
+            ..Run::default()
+        };
+        let words = sent(&run, &[(0, true), (3, false)], &here);
+        let there = Writer::new(start);
+        // Sample 1's base came from the earlier run, on this rank.
+        assert!(there.set_base(1, 4));
+        receive(&words, &there).unwrap();
+        assert_eq!(there.finish(), {
+            assert!(here.set_base(1, 4));
+            here.finish()
+        });
+        // A message cut short is an error, not a panic.
+        assert!(receive(&words[..words.len() - 1], &Writer::new(vec![0, 3, 5])).is_err());
     }
 }

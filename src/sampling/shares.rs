@@ -147,6 +147,55 @@ impl Writer {
     }
 
     /// The written shares.
+    /// Share `slot` as one word (its step above its units), and its cell where the step is too
+    /// long for 16 bits; and the base cell of sample `k` (the cell of its first share).
+    pub fn word(&self, slot: usize) -> (u32, Option<u32>) {
+        let step = self
+            .steps
+            .get(slot)
+            .map_or(0, |s| s.load(Ordering::Relaxed));
+        let units = self
+            .units
+            .get(slot)
+            .map_or(0, |u| u.load(Ordering::Relaxed));
+        let far = (step == FAR)
+            .then(|| {
+                let far = self.far.lock().unwrap_or_else(|e| e.into_inner());
+                far.iter().find(|f| f.0 == slot as u32).map(|f| f.1)
+            })
+            .flatten();
+        (u32::from(step) << 16 | u32::from(units), far)
+    }
+
+    /// The base cell written for sample `k`.
+    pub fn base(&self, k: usize) -> u32 {
+        self.base.get(k).map_or(0, |b| b.load(Ordering::Relaxed))
+    }
+
+    /// Writes what [`Writer::word`] read on another rank; false if out of range.
+    pub fn put(&self, slot: usize, word: u32, far: Option<u32>) -> bool {
+        let (Some(s), Some(u)) = (self.steps.get(slot), self.units.get(slot)) else {
+            return false;
+        };
+        s.store((word >> 16) as u16, Ordering::Relaxed);
+        u.store(word as u16, Ordering::Relaxed);
+        if let Some(cell) = far {
+            self.far
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push((slot as u32, cell));
+        }
+        true
+    }
+
+    /// Sets sample `k`'s base cell (read on another rank); false if out of range.
+    pub fn set_base(&self, k: usize, cell: u32) -> bool {
+        self.base
+            .get(k)
+            .map(|b| b.store(cell, Ordering::Relaxed))
+            .is_some()
+    }
+
     pub fn finish(self) -> Shares {
         let mut far = self.far.into_inner().unwrap_or_else(|e| e.into_inner());
         far.sort_unstable();
