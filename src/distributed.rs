@@ -165,6 +165,51 @@ pub(crate) fn all_gather_words(ranks: &dyn Ranks, mine: &[u32]) -> Result<(Vec<u
     Ok((out, counts))
 }
 
+/// This rank's run of `len` items cut in chunks of `chunk`: whole chunks, so that each rank
+/// cuts its run where one process would (work done chunk by chunk then does not depend on the
+/// ranks either).
+pub(crate) fn share_of(ranks: &dyn Ranks, len: usize, chunk: usize) -> std::ops::Range<usize> {
+    let (rank, size) = (ranks.rank(), ranks.size().max(1));
+    let chunks = len.div_ceil(chunk.max(1));
+    let edge = |r: usize| (r * chunks / size * chunk).min(len);
+    edge(rank)..edge(rank + 1)
+}
+
+/// Every rank's run of `out` ([`share_of`]) to every rank, as `W` numbers an item.
+pub(crate) fn gather_shares<T, const W: usize>(
+    ranks: &dyn Ranks,
+    out: &mut [T],
+    chunk: usize,
+    put: impl Fn(&T) -> [f64; W],
+    take: impl Fn(&[f64]) -> T,
+) -> Result<()> {
+    let size = ranks.size().max(1);
+    if size == 1 {
+        return Ok(());
+    }
+    let counts: Vec<usize> = (0..size)
+        .map(|rank| W * share_of(&Fixed { rank, size }, out.len(), chunk).len())
+        .collect();
+    let mine: Vec<f64> = out[share_of(ranks, out.len(), chunk)]
+        .iter()
+        .flat_map(&put)
+        .collect();
+    let mut all = vec![0.0; W * out.len()];
+    ranks.all_gather(&mine, &counts, &mut all)?;
+    for (item, values) in out.iter_mut().zip(all.chunks_exact(W)) {
+        *item = take(values);
+    }
+    Ok(())
+}
+
+/// A count summed over the ranks.
+pub(crate) fn sum_over(ranks: &dyn Ranks, count: u64) -> Result<u64> {
+    if ranks.size() <= 1 {
+        return Ok(count);
+    }
+    Ok(gather_one(ranks, count as f64)?.iter().sum::<f64>() as u64)
+}
+
 /// Whether any rank says yes.
 pub(crate) fn any(ranks: &dyn Ranks, yes: bool) -> Result<bool> {
     if ranks.size() <= 1 {

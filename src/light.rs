@@ -71,6 +71,9 @@ pub struct Arrival {
 }
 
 impl DirectLight {
+    /// Receivers per chunk of [`DirectLight::at`]'s work.
+    pub(crate) const CHUNK: usize = 256;
+
     /// Prepares the lights; `light_samples` shadow rays per area light and receiver.
     pub fn new(scene: &Scene, light_samples: u32) -> DirectLight {
         let emitters = scene
@@ -208,7 +211,7 @@ impl DirectLight {
             queries.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
             Ok(())
         };
-        for_chunks_reporting(&mut out, 256, threads, work, report)?;
+        for_chunks_reporting(&mut out, Self::CHUNK, threads, work, report)?;
         Ok((out, queries.into_inner()))
     }
 

@@ -251,7 +251,7 @@ pub fn render_distributed(
             );
             Ok(())
         };
-        let mine = ranks_share(ranks, centre.len(), w * 4);
+        let mine = crate::distributed::share_of(ranks, centre.len(), w * 4);
         let all = !reporter.stopped()
             && for_chunks_reporting(
                 &mut centre[mine.clone()],
@@ -266,11 +266,11 @@ pub fn render_distributed(
                 },
             )?;
         let all = !crate::distributed::any(ranks, !all)?;
-        gather_share(
+        crate::distributed::gather_shares(
             ranks,
             &mut centre,
             w * 4,
-            |c| [c.0.x, c.0.y, c.0.z, c.1 as f32].map(f64::from),
+            |c: &(Vec3, u32)| [c.0.x, c.0.y, c.0.z, c.1 as f32].map(f64::from),
             |v| {
                 (
                     Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32),
@@ -294,7 +294,7 @@ pub fn render_distributed(
             );
             Ok(())
         };
-        let mine = ranks_share(ranks, refined.len(), 64);
+        let mine = crate::distributed::share_of(ranks, refined.len(), 64);
         let all = all
             && for_chunks_reporting(
                 &mut refined[mine.clone()],
@@ -309,11 +309,11 @@ pub fn render_distributed(
                 },
             )?;
         let all = !crate::distributed::any(ranks, !all)?;
-        gather_share(
+        crate::distributed::gather_shares(
             ranks,
             &mut refined,
             64,
-            |r| match r {
+            |r: &Option<Vec3>| match r {
                 Some(v) => [1.0, f64::from(v.x), f64::from(v.y), f64::from(v.z)],
                 None => [0.0; 4],
             },
@@ -321,8 +321,8 @@ pub fn render_distributed(
         )?;
         stats.camera_rays += (edges.first_ray.last().copied().unwrap_or(w * h) - w * h) as u64;
         stats.supersampled_pixels = refined.iter().filter(|r| r.is_some()).count() as u64;
-        stats.interpolation_queries = sum_over(ranks, queries.into_inner())?;
-        stats.shadow_rays = sum_over(ranks, shader.shadow_rays.into_inner())?;
+        stats.interpolation_queries = crate::distributed::sum_over(ranks, queries.into_inner())?;
+        stats.shadow_rays = crate::distributed::sum_over(ranks, shader.shadow_rays.into_inner())?;
         stats.stopped = !all;
 
         let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
@@ -340,63 +340,6 @@ pub fn render_distributed(
             stats,
         ))
     })
-}
-
-/// This rank's run of `len` items cut in chunks of `chunk`: whole chunks, so that each rank
-/// cuts its run where one process would.
-fn ranks_share(
-    ranks: &dyn crate::distributed::Ranks,
-    len: usize,
-    chunk: usize,
-) -> std::ops::Range<usize> {
-    let (rank, size) = (ranks.rank(), ranks.size().max(1));
-    let chunks = len.div_ceil(chunk.max(1));
-    let edge = |r: usize| (r * chunks / size * chunk).min(len);
-    edge(rank)..edge(rank + 1)
-}
-
-/// Every rank's run of `out` (see [`ranks_share`]) to every rank, as four numbers an item.
-fn gather_share<T>(
-    ranks: &dyn crate::distributed::Ranks,
-    out: &mut [T],
-    chunk: usize,
-    put: impl Fn(&T) -> [f64; 4],
-    take: impl Fn(&[f64]) -> T,
-) -> Result<()> {
-    let size = ranks.size().max(1);
-    if size == 1 {
-        return Ok(());
-    }
-    let counts: Vec<usize> = (0..size)
-        .map(|r| {
-            let share = ranks_share(
-                &crate::distributed::Fixed { rank: r, size },
-                out.len(),
-                chunk,
-            );
-            4 * share.len()
-        })
-        .collect();
-    let mine: Vec<f64> = out[ranks_share(ranks, out.len(), chunk)]
-        .iter()
-        .flat_map(&put)
-        .collect();
-    let mut all = vec![0.0; 4 * out.len()];
-    ranks.all_gather(&mine, &counts, &mut all)?;
-    for (item, values) in out.iter_mut().zip(all.chunks_exact(4)) {
-        *item = take(values);
-    }
-    Ok(())
-}
-
-/// A count summed over the ranks.
-fn sum_over(ranks: &dyn crate::distributed::Ranks, count: u64) -> Result<u64> {
-    if ranks.size() <= 1 {
-        return Ok(count);
-    }
-    Ok(crate::distributed::gather_one(ranks, count as f64)?
-        .iter()
-        .sum::<f64>() as u64)
 }
 
 fn control(stop: bool) -> Control {

@@ -67,8 +67,9 @@ pub struct RefineSettings {
 }
 
 /// Eq. 7's error of every sample, relative to the mean luminance of `radiosity`; NaN where a
-/// sample has no neighbour within 2D that it sees along its side. On up to `threads` threads;
-/// `None` if `report` answered Stop.
+/// sample has no neighbour within 2D that it sees along its side. On up to `threads` threads,
+/// each rank of `ranks` measuring a run of the samples; `None` if `report` answered Stop (on
+/// any rank).
 #[allow(clippy::too_many_arguments)]
 pub fn errors(
     samples: &Samples,
@@ -77,7 +78,7 @@ pub fn errors(
     obstruction: &Obstruction,
     vis: &dyn Visibility,
     radiosity: &[DVec3],
-    threads: usize,
+    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
     report: Report,
 ) -> Result<Option<Vec<f64>>> {
     let n = samples.len();
@@ -105,8 +106,19 @@ pub fn errors(
         }
         Ok(())
     };
-    let all = for_chunks_reporting(&mut out, 1024, threads, error, report)?;
-    Ok(all.then_some(out))
+    let mine = crate::distributed::share_of(ranks, n, 1024);
+    let all = for_chunks_reporting(
+        &mut out[mine.clone()],
+        1024,
+        threads,
+        |first, chunk| error(mine.start + first, chunk),
+        report,
+    )?;
+    if crate::distributed::any(ranks, !all)? {
+        return Ok(None);
+    }
+    crate::distributed::gather_shares(ranks, &mut out, 1024, |&e| [e], |v| v[0])?;
+    Ok(Some(out))
 }
 
 /// Refines where the error exceeds ζ: shrinks those samples' radii and adds new samples
@@ -121,6 +133,7 @@ pub fn refine(
     vis: &dyn Visibility,
     radiosity: &[DVec3],
     settings: RefineSettings,
+    ranks: &dyn crate::distributed::Ranks,
     report: Report,
 ) -> Result<Refinement> {
     // The errors take the first half of the phase's share, the darts the second.
@@ -131,7 +144,7 @@ pub fn refine(
         obstruction,
         vis,
         radiosity,
-        settings.threads,
+        (settings.threads, ranks),
         &mut |f| report(0.5 * f),
     )?
     else {
@@ -193,6 +206,8 @@ pub fn refine(
     let mut next: Vec<usize> = groups.iter().map(|g| g.start).collect();
     let mut thrown = 0u64;
     let shared: &Samples = samples;
+    // Over several ranks, each fills every size-th side's discs.
+    let (rank, size) = (ranks.rank(), ranks.size().max(1));
     loop {
         let pieces: Vec<std::ops::Range<usize>> = groups
             .iter()
@@ -213,6 +228,10 @@ pub fn refine(
         let mut work: Vec<(usize, &mut Vec<(Vec2, f32)>)> = placed.iter_mut().enumerate().collect();
         for_chunks(&mut work, 1, settings.threads, |_, out| {
             let (g, points) = &mut out[0];
+            if *g % size != rank {
+                // Another rank's side.
+                return Ok(());
+            }
             let piece = &discs[pieces[*g].clone()];
             if !piece.is_empty() {
                 fill_discs(shared, maps, index, piece, settings, old, points);
@@ -227,7 +246,12 @@ pub fn refine(
             next[g] = piece.end;
         }
         let more = next.iter().zip(&groups).any(|(&n, g)| n < g.end);
-        if more && report(0.5 + 0.5 * thrown as f64 / total_darts.max(1) as f64) == Control::Stop {
+        if more
+            && crate::distributed::any(
+                ranks,
+                report(0.5 + 0.5 * thrown as f64 / total_darts.max(1) as f64) == Control::Stop,
+            )?
+        {
             // The discs not filled keep their radii: as if they had not been refined.
             for (g, &from) in groups.iter().zip(&next) {
                 for &(k, old_radius, _) in &discs[from..g.end] {
@@ -241,6 +265,9 @@ pub fn refine(
     if next.iter().zip(&groups).all(|(&n, g)| n == g.end) {
         report(1.0);
     }
+    if size > 1 {
+        share_points(ranks, &mut placed)?;
+    }
     'sides: for (group, points) in groups.iter().zip(placed) {
         let side = samples.side[discs[group.start].0];
         for (p, radius) in points {
@@ -253,6 +280,46 @@ pub fn refine(
         }
     }
     Ok(result)
+}
+
+/// Every rank's sides' new points (rank r filled every size-th side from r) to every rank.
+fn share_points(
+    ranks: &dyn crate::distributed::Ranks,
+    placed: &mut [Vec<(Vec2, f32)>],
+) -> Result<()> {
+    let (rank, size) = (ranks.rank(), ranks.size().max(1));
+    // Per side: its index, its count, then (u, v, radius) a point; f32 is exact in f64.
+    let mut mine = Vec::new();
+    for (g, points) in placed.iter().enumerate().skip(rank).step_by(size) {
+        mine.extend([g as f64, points.len() as f64]);
+        for (p, r) in points {
+            mine.extend([f64::from(p.x), f64::from(p.y), f64::from(*r)]);
+        }
+    }
+    let counts: Vec<usize> = crate::distributed::gather_one(ranks, mine.len() as f64)?
+        .iter()
+        .map(|&c| c as usize)
+        .collect();
+    let mut all = vec![0.0; counts.iter().sum()];
+    ranks.all_gather(&mine, &counts, &mut all)?;
+    let broken = || crate::Error::Worker {
+        problem: "a rank sent sample points that do not read back (a transport error)".into(),
+    };
+    let mut at = 0;
+    while at < all.len() {
+        let head = all.get(at..at + 2).ok_or_else(broken)?;
+        let (g, len) = (head[0] as usize, head[1] as usize);
+        at += 2;
+        let body = all.get(at..at + 3 * len).ok_or_else(broken)?;
+        at += 3 * len;
+        if g % size != rank {
+            *placed.get_mut(g).ok_or_else(broken)? = body
+                .chunks_exact(3)
+                .map(|v| (Vec2::new(v[0] as f32, v[1] as f32), v[2] as f32))
+                .collect();
+        }
+    }
+    Ok(())
 }
 
 /// Eq. 8's Poisson-disk darts in the discs of one side, in order: the new points with their

@@ -223,14 +223,40 @@ impl Solve<'_> {
             )
         } else {
             let base = self.base(Phase::DirectLight, round, n);
-            let (arrivals, queries) = self.light.at(
+            // Each rank a run of the samples, in the light's own chunks.
+            let ranks = self.ranks;
+            let mine = crate::distributed::share_of(ranks, points.len(), DirectLight::CHUNK);
+            let (part, queries) = self.light.at(
                 vis,
-                &points,
-                &ids,
+                &points[mine.clone()],
+                &ids[mine.clone()],
                 options.seed,
                 threads,
                 &mut self.reporter.part(base),
             )?;
+            let mut arrivals = vec![Arrival::default(); points.len()];
+            arrivals[mine].copy_from_slice(&part);
+            drop(part);
+            crate::distributed::gather_shares(
+                ranks,
+                &mut arrivals,
+                DirectLight::CHUNK,
+                |a: &Arrival| {
+                    [
+                        a.irradiance.x,
+                        a.irradiance.y,
+                        a.irradiance.z,
+                        f64::from(a.visible),
+                        a.dark_emitters,
+                    ]
+                },
+                |v| Arrival {
+                    irradiance: DVec3::new(v[0], v[1], v[2]),
+                    visible: v[3] as f32,
+                    dark_emitters: v[4],
+                },
+            )?;
+            let queries = crate::distributed::sum_over(ranks, queries)?;
             let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
             (arrivals, queries, covered)
         };
@@ -265,7 +291,7 @@ impl Solve<'_> {
             &arrivals,
             self.epsilon,
             options.alpha,
-            threads,
+            (threads, self.ranks),
         )?;
         if round == 0 {
             // Direct light that reached no sample area left the scene.
@@ -464,6 +490,7 @@ impl Solve<'_> {
                     .max_samples
                     .min(options.memory_budget / 2 / crate::budget::BYTES_PER_SAMPLE),
             },
+            self.ranks,
             &mut self.reporter.part(base),
         )?;
         // A Stop heard while the errors were measured added nothing; one heard at their last

@@ -44,7 +44,8 @@ fn specular_direct(solution: &Solution, k: usize) -> DVec3 {
 }
 
 /// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their
-/// unshot radiosity for a (warm) start: see the module doc. On up to `threads` threads.
+/// unshot radiosity for a (warm) start: see the module doc. On up to `threads` threads, each
+/// rank a run of the new samples.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn start(
     scene: &Scene,
@@ -54,13 +55,16 @@ pub(crate) fn start(
     arrivals: &[Arrival],
     epsilon: f32,
     alpha: f32,
-    threads: usize,
+    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
 ) -> Result<()> {
     let n = solution.samples.len();
     // (irradiance, unshot, radiosity) of each new sample.
     let mut out = vec![(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); n - first_new];
     let shared: &Solution = solution;
-    for_chunks(&mut out, 256, threads, |first, chunk| {
+    let mine = crate::distributed::share_of(ranks, out.len(), 256);
+    let offset = mine.start;
+    for_chunks(&mut out[mine], 256, threads, |first, chunk| {
+        let first = offset + first;
         let samples = &shared.samples;
         let mut near = Vec::new();
         let r = 2.0 * epsilon;
@@ -107,6 +111,19 @@ pub(crate) fn start(
         }
         Ok(())
     })?;
+    crate::distributed::gather_shares(
+        ranks,
+        &mut out,
+        256,
+        |(h, u, b)| [h.x, h.y, h.z, u.x, u.y, u.z, b.x, b.y, b.z],
+        |v| {
+            (
+                DVec3::new(v[0], v[1], v[2]),
+                DVec3::new(v[3], v[4], v[5]),
+                DVec3::new(v[6], v[7], v[8]),
+            )
+        },
+    )?;
     // Exactly: a round's new samples would leave up to as many slots unused.
     solution.direct.reserve_exact(arrivals.len());
     solution.irradiance.reserve_exact(out.len());
