@@ -202,6 +202,50 @@ pub(crate) fn gather_shares<T, const W: usize>(
     Ok(())
 }
 
+/// Lists filled rank by rank (rank r filled every size-th list from r) to every rank, as `W`
+/// numbers an item.
+pub(crate) fn share_lists<T, const W: usize>(
+    ranks: &dyn Ranks,
+    lists: &mut [Vec<T>],
+    put: impl Fn(&T) -> [f64; W],
+    take: impl Fn(&[f64]) -> T,
+) -> Result<()> {
+    let (rank, size) = (ranks.rank(), ranks.size().max(1));
+    if size == 1 {
+        return Ok(());
+    }
+    // Per list: its index, its length, then its items.
+    let mut mine = Vec::new();
+    for (i, list) in lists.iter().enumerate().skip(rank).step_by(size) {
+        mine.extend([i as f64, list.len() as f64]);
+        for item in list {
+            mine.extend(put(item));
+        }
+    }
+    let counts: Vec<usize> = gather_one(ranks, mine.len() as f64)?
+        .iter()
+        .map(|&c| c as usize)
+        .collect();
+    let mut all = vec![0.0; counts.iter().sum()];
+    ranks.all_gather(&mine, &counts, &mut all)?;
+    drop(mine);
+    let broken = || Error::Worker {
+        problem: "a rank sent lists that do not read back (a transport error)".into(),
+    };
+    let mut at = 0;
+    while at < all.len() {
+        let head = all.get(at..at + 2).ok_or_else(broken)?;
+        let (i, len) = (head[0] as usize, head[1] as usize);
+        at += 2;
+        let body = all.get(at..at + W * len).ok_or_else(broken)?;
+        at += W * len;
+        if i % size != rank {
+            *lists.get_mut(i).ok_or_else(broken)? = body.chunks_exact(W).map(&take).collect();
+        }
+    }
+    Ok(())
+}
+
 /// A count summed over the ranks.
 pub(crate) fn sum_over(ranks: &dyn Ranks, count: u64) -> Result<u64> {
     if ranks.size() <= 1 {

@@ -422,12 +422,13 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
             let exchanges = (sh.shots + 1).max(1);
             let _ = writeln!(
                 out,
-                "ranks: {size}; links held per rank at most {} of {} ({:.2}x), round {}; rank 0 \
-                 received {} a sweep from the others",
+                "ranks: {size}; links held per rank at most {} of {} ({:.2}x), round {}; each \
+                 sweep all-gathers {} (24 bytes a sample), of which rank 0 received {}",
                 sh.most_held_links,
                 sh.links,
                 sh.most_held_links as f64 / sh.links.max(1) as f64,
                 r.round,
+                meshlight::budget::human_bytes(24.0 * r.samples as f64),
                 meshlight::budget::human_bytes(sh.exchanged_bytes as f64 / exchanges as f64),
             );
         }

@@ -23,6 +23,9 @@ use crate::visibility::Visibility;
 /// Cells per run.
 const RUN: usize = 1024;
 
+/// Runs filled between two exchanges over several ranks (some four million shares).
+const EXCHANGE_RUNS: usize = 512;
+
 /// No cell (a sample's first share has no previous one).
 pub(super) const NONE: u32 = u32::MAX;
 
@@ -383,22 +386,27 @@ impl Splitter<'_> {
             }
             Ok(())
         };
-        for_chunks(runs, 1, threads, fill)?;
         if size == 1 {
-            return Ok(());
+            return for_chunks(runs, 1, threads, fill);
         }
-        let mine: Vec<u32> = runs
-            .iter_mut()
-            .flat_map(|r| std::mem::take(&mut r.sent))
-            .collect();
-        let (words, counts) = crate::distributed::all_gather_words(ranks, &mine)?;
-        drop(mine);
-        let mut at = 0;
-        for (r, &count) in counts.iter().enumerate() {
-            if r != rank {
-                receive(&words[at..at + count], writer)?;
+        // The filled runs cross in batches, so that what is in flight stays small beside the
+        // shares (all at once, the 2 x 2-room gallery's ranks peaked 20% above one process).
+        for (b, batch) in runs.chunks_mut(EXCHANGE_RUNS).enumerate() {
+            let first = b * EXCHANGE_RUNS;
+            for_chunks(batch, 1, threads, |i, out| fill(first + i, out))?;
+            let mut mine = Vec::with_capacity(batch.iter().map(|r| r.sent.len()).sum());
+            for run in batch.iter_mut() {
+                mine.extend_from_slice(&std::mem::take(&mut run.sent));
             }
-            at += count;
+            let (words, counts) = crate::distributed::all_gather_words(ranks, &mine)?;
+            drop(mine);
+            let mut at = 0;
+            for (r, &count) in counts.iter().enumerate() {
+                if r != rank {
+                    receive(&words[at..at + count], writer)?;
+                }
+                at += count;
+            }
         }
         Ok(())
     }

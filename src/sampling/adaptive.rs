@@ -265,9 +265,12 @@ pub fn refine(
     if next.iter().zip(&groups).all(|(&n, g)| n == g.end) {
         report(1.0);
     }
-    if size > 1 {
-        share_points(ranks, &mut placed)?;
-    }
+    crate::distributed::share_lists(
+        ranks,
+        &mut placed,
+        |(p, r)| [p.x, p.y, *r].map(f64::from),
+        |v| (Vec2::new(v[0] as f32, v[1] as f32), v[2] as f32),
+    )?;
     'sides: for (group, points) in groups.iter().zip(placed) {
         let side = samples.side[discs[group.start].0];
         for (p, radius) in points {
@@ -280,46 +283,6 @@ pub fn refine(
         }
     }
     Ok(result)
-}
-
-/// Every rank's sides' new points (rank r filled every size-th side from r) to every rank.
-fn share_points(
-    ranks: &dyn crate::distributed::Ranks,
-    placed: &mut [Vec<(Vec2, f32)>],
-) -> Result<()> {
-    let (rank, size) = (ranks.rank(), ranks.size().max(1));
-    // Per side: its index, its count, then (u, v, radius) a point; f32 is exact in f64.
-    let mut mine = Vec::new();
-    for (g, points) in placed.iter().enumerate().skip(rank).step_by(size) {
-        mine.extend([g as f64, points.len() as f64]);
-        for (p, r) in points {
-            mine.extend([f64::from(p.x), f64::from(p.y), f64::from(*r)]);
-        }
-    }
-    let counts: Vec<usize> = crate::distributed::gather_one(ranks, mine.len() as f64)?
-        .iter()
-        .map(|&c| c as usize)
-        .collect();
-    let mut all = vec![0.0; counts.iter().sum()];
-    ranks.all_gather(&mine, &counts, &mut all)?;
-    let broken = || crate::Error::Worker {
-        problem: "a rank sent sample points that do not read back (a transport error)".into(),
-    };
-    let mut at = 0;
-    while at < all.len() {
-        let head = all.get(at..at + 2).ok_or_else(broken)?;
-        let (g, len) = (head[0] as usize, head[1] as usize);
-        at += 2;
-        let body = all.get(at..at + 3 * len).ok_or_else(broken)?;
-        at += 3 * len;
-        if g % size != rank {
-            *placed.get_mut(g).ok_or_else(broken)? = body
-                .chunks_exact(3)
-                .map(|v| (Vec2::new(v[0] as f32, v[1] as f32), v[2] as f32))
-                .collect();
-        }
-    }
-    Ok(())
 }
 
 /// Eq. 8's Poisson-disk darts in the discs of one side, in order: the new points with their

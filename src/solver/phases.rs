@@ -81,7 +81,12 @@ impl Solve<'_> {
         let threads = self.options.threads.max(1);
         if !self.reporter.stopped() {
             let base = self.base(Phase::Sampling, 0, 0);
+            // Over several ranks, each places every size-th side.
+            let (rank, size) = (self.ranks.rank(), self.ranks.size().max(1));
             let place = |i: usize, out: &mut [Vec<glam::Vec2>]| {
+                if i % size != rank {
+                    return Ok(());
+                }
                 let side = sides[i];
                 out[0] =
                     poisson::sample_side(&maps[surface_of(side) as usize], side, epsilon, seed);
@@ -93,6 +98,12 @@ impl Solve<'_> {
                 threads,
                 place,
                 &mut self.reporter.part(base),
+            )?;
+            crate::distributed::share_lists(
+                self.ranks,
+                &mut per_side,
+                |p| [p.x, p.y].map(f64::from),
+                |v| glam::Vec2::new(v[0] as f32, v[1] as f32),
             )?;
         }
         let mut samples = Samples::default();
