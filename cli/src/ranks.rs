@@ -155,6 +155,22 @@ mod mpi_ranks {
         Ok((sizes, displs))
     }
 
+    impl Mpi {
+        /// One MPI_Allgatherv of values of either kind.
+        fn gather<T: Equivalence>(
+            &self,
+            mine: &[T],
+            counts: &[usize],
+            out: &mut [T],
+        ) -> meshlight::Result<()> {
+            check(mine.len(), counts, out.len(), self.world.rank() as usize)?;
+            let (sizes, displs) = partition(counts)?;
+            let mut partition = PartitionMut::new(out, sizes, displs);
+            self.world.all_gather_varcount_into(mine, &mut partition);
+            Ok(())
+        }
+    }
+
     impl Ranks for Mpi {
         fn rank(&self) -> usize {
             self.world.rank() as usize
@@ -170,11 +186,7 @@ mod mpi_ranks {
             counts: &[usize],
             out: &mut [f64],
         ) -> meshlight::Result<()> {
-            check(mine.len(), counts, out.len(), self.rank())?;
-            let (sizes, displs) = partition(counts)?;
-            let mut partition = PartitionMut::new(out, sizes, displs);
-            self.world.all_gather_varcount_into(mine, &mut partition);
-            Ok(())
+            self.gather(mine, counts, out)
         }
 
         fn all_gather_words(
@@ -183,11 +195,7 @@ mod mpi_ranks {
             counts: &[usize],
             out: &mut [u32],
         ) -> meshlight::Result<()> {
-            check(mine.len(), counts, out.len(), self.rank())?;
-            let (sizes, displs) = partition(counts)?;
-            let mut partition = PartitionMut::new(out, sizes, displs);
-            self.world.all_gather_varcount_into(mine, &mut partition);
-            Ok(())
+            self.gather(mine, counts, out)
         }
 
         fn exchange(&self, to: &[Vec<u32>]) -> meshlight::Result<Vec<Vec<u32>>> {
