@@ -31,6 +31,9 @@ fn alone(args: &[&str]) -> Output {
 /// `mpirun -np n meshlight args` (as root in CI containers, and more ranks than cores).
 fn mpirun(n: usize, args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut command = Command::new("mpirun");
+    // Containers often forbid the cross-memory attach Open MPI's shared memory uses for large
+    // messages (it then fails with "Read -1"): copy through shared memory instead.
+    command.env("OMPI_MCA_btl_vader_single_copy_mechanism", "none");
     command.args([
         "--allow-run-as-root",
         "--oversubscribe",
