@@ -3,13 +3,13 @@
 //!
 //! Every rank runs the same solve on the same scene and options. What is cheap to repeat or
 //! must be the same everywhere is replicated: the geometry, the visibility structure, the
-//! samples (placed deterministically, so every rank places the same ones), the cluster tree and
-//! the per-sample state. What grows fastest is dealt out: the cluster tree's receiver groups go
-//! to the ranks in contiguous runs of about equal samples, and each rank builds and keeps only
-//! the links into its own groups, so the links held per rank fall about as 1/N. Each sweep
-//! every rank gathers its groups' irradiance and one all-gather gives every rank everyone's
-//! (24 bytes a sample); the rest of the sweep (the balance, the new unshot radiosity, the
-//! specular transfer) is the same arithmetic in the same order on every rank, so the result is
+//! samples (placed deterministically), the cluster tree and the per-sample state. The work is
+//! dealt out where one process cuts it (sides, runs of cells, chunks of samples or pixels, link
+//! jobs) and what each rank finds is all-gathered; the cluster tree's receiver groups go to the
+//! ranks in contiguous runs of about equal links, and each rank keeps only the links into its
+//! own groups, so the links held per rank fall about as 1/N. Each sweep every rank gathers its
+//! groups' irradiance and one all-gather gives every rank everyone's (24 bytes a sample); the
+//! rest of the sweep is the same arithmetic in the same order on every rank, so the result is
 //! the single-process solve's, bit for bit. See `docs/distributed.md`.
 //!
 //! The CLI implements [`Ranks`] over MPI (its `mpi` feature); a host may implement it over its
@@ -165,6 +165,11 @@ pub(crate) fn all_gather_words(ranks: &dyn Ranks, mine: &[u32]) -> Result<(Vec<u
     Ok((out, counts))
 }
 
+/// Whether item `i` of a list dealt in turn (rank r takes items r, r + N, …) is this rank's.
+pub(crate) fn deals(ranks: &dyn Ranks, i: usize) -> bool {
+    i % ranks.size().max(1) == ranks.rank()
+}
+
 /// This rank's run of `len` items cut in chunks of `chunk`: whole chunks, so that each rank
 /// cuts its run where one process would (work done chunk by chunk then does not depend on the
 /// ranks either).
@@ -202,7 +207,35 @@ pub(crate) fn gather_shares<T, const W: usize>(
     Ok(())
 }
 
-/// Lists filled rank by rank (rank r filled every size-th list from r) to every rank, as `W`
+/// [`for_chunks_reporting`](crate::parallel::for_chunks_reporting) over this rank's run of
+/// `out` ([`share_of`]), then every rank's run to every rank as `W` numbers an item. Whether
+/// every rank went through its run (a Stop on any rank: no).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn for_share<T: Send, const W: usize>(
+    ranks: &dyn Ranks,
+    out: &mut [T],
+    chunk: usize,
+    threads: usize,
+    f: impl Fn(usize, &mut [T]) -> Result<()> + Sync,
+    report: crate::parallel::Report,
+    put: impl Fn(&T) -> [f64; W],
+    take: impl Fn(&[f64]) -> T,
+) -> Result<bool> {
+    let mine = share_of(ranks, out.len(), chunk);
+    let offset = mine.start;
+    let all = crate::parallel::for_chunks_reporting(
+        &mut out[mine],
+        chunk,
+        threads,
+        |first, part| f(offset + first, part),
+        report,
+    )?;
+    let all = !any(ranks, !all)?;
+    gather_shares(ranks, out, chunk, put, take)?;
+    Ok(all)
+}
+
+/// Lists filled rank by rank (each rank the lists it [`deals`]) to every rank, as `W`
 /// numbers an item.
 pub(crate) fn share_lists<T, const W: usize>(
     ranks: &dyn Ranks,
@@ -210,13 +243,12 @@ pub(crate) fn share_lists<T, const W: usize>(
     put: impl Fn(&T) -> [f64; W],
     take: impl Fn(&[f64]) -> T,
 ) -> Result<()> {
-    let (rank, size) = (ranks.rank(), ranks.size().max(1));
-    if size == 1 {
+    if ranks.size() <= 1 {
         return Ok(());
     }
     // Per list: its index, its length, then its items.
     let mut mine = Vec::new();
-    for (i, list) in lists.iter().enumerate().skip(rank).step_by(size) {
+    for (i, list) in lists.iter().enumerate().filter(|&(i, _)| deals(ranks, i)) {
         mine.extend([i as f64, list.len() as f64]);
         for item in list {
             mine.extend(put(item));
@@ -239,7 +271,7 @@ pub(crate) fn share_lists<T, const W: usize>(
         at += 2;
         let body = all.get(at..at + W * len).ok_or_else(broken)?;
         at += W * len;
-        if i % size != rank {
+        if !deals(ranks, i) {
             *lists.get_mut(i).ok_or_else(broken)? = body.chunks_exact(W).map(&take).collect();
         }
     }
@@ -264,14 +296,14 @@ pub(crate) fn any(ranks: &dyn Ranks, yes: bool) -> Result<bool> {
         .any(|&v| v != 0.0))
 }
 
-/// The rank that owns each of `groups` receiver groups, given each group's samples: contiguous
-/// runs of about equal samples, a group going to the rank its middle sample falls in. Rank r
-/// owns a run of groups, so its groups' samples are one run of the tree's order.
-pub(crate) fn owners(members: &[usize], size: usize) -> Vec<usize> {
+/// The rank that owns each item given its weight: contiguous runs of about equal weight, an
+/// item going to the rank its weight's middle falls in (receiver groups by their links, so that
+/// a rank's groups' samples are one run of the tree's order).
+pub(crate) fn owners(weights: &[usize], size: usize) -> Vec<usize> {
     let size = size.max(1);
-    let total: usize = members.iter().sum();
+    let total: usize = weights.iter().sum();
     let mut first = 0usize;
-    members
+    weights
         .iter()
         .map(|&m| {
             let middle = first + m / 2;

@@ -36,7 +36,8 @@ pub struct AreaStats {
 }
 
 /// Computes every sample's area `S`, on up to `threads` threads and over `ranks` (the result
-/// depends on neither: the first pass's runs are dealt to the ranks and all-gathered). With `changed` (per side), only the sides it marks are recomputed: the
+/// depends on neither: the split's runs are dealt to the ranks and all-gathered). With
+/// `changed` (per side), only the sides it marks are recomputed: the
 /// others keep the cells and shares the last computation gave them (their samples and radii
 /// must not have changed since). `report` hears the share of cells done now and then; if it
 /// answers Stop, the cells not split yet go whole to their nearest sample, so every side's

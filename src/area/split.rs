@@ -284,9 +284,11 @@ impl Splitter<'_> {
         report: Report,
     ) -> Result<Vec<Run>> {
         let cells = &layout.cells;
-        let (rank, size) = (ranks.rank(), ranks.size().max(1));
+        let size = ranks.size().max(1);
         let all = cells.len().div_ceil(RUN);
-        let mine: Vec<usize> = (rank..all).step_by(size).collect();
+        let mine: Vec<usize> = (0..all)
+            .filter(|&r| crate::distributed::deals(ranks, r))
+            .collect();
         let mut runs = vec![Run::default(); mine.len()];
         let count = |i: usize, out: &mut [Run]| {
             let r = mine[i];
@@ -349,7 +351,7 @@ impl Splitter<'_> {
         let mut at = 0;
         while at < words.len() {
             let (r, run) = Run::take(&words, &mut at)?;
-            if r % size != rank {
+            if !crate::distributed::deals(ranks, r) {
                 *every.get_mut(r).ok_or_else(broken)? = run;
             }
         }
@@ -370,7 +372,7 @@ impl Splitter<'_> {
     ) -> Result<()> {
         let (rank, size) = (ranks.rank(), ranks.size().max(1));
         let fill = |r: usize, out: &mut [Run]| {
-            if r % size != rank {
+            if !crate::distributed::deals(ranks, r) {
                 return Ok(());
             }
             let run = &mut out[0];

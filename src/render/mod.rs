@@ -16,7 +16,6 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::light::DirectLight;
-use crate::parallel::for_chunks_reporting;
 use crate::progress::{Callback, Control, Phase, Progress, Reporter};
 use crate::sampling::{side_of, surface_of, Side};
 use crate::scene::Scene;
@@ -251,25 +250,19 @@ pub fn render_distributed(
             );
             Ok(())
         };
-        let mine = crate::distributed::share_of(ranks, centre.len(), w * 4);
-        let all = !reporter.stopped()
-            && for_chunks_reporting(
-                &mut centre[mine.clone()],
-                w * 4,
-                options.threads,
-                |first, out| trace(mine.start + first, out),
-                &mut |f| {
-                    control(reporter.report(Progress {
-                        fraction: CENTRE_SHARE * f,
-                        ..base
-                    }))
-                },
-            )?;
-        let all = !crate::distributed::any(ranks, !all)?;
-        crate::distributed::gather_shares(
+        // Each rank a run of the rows (a Stop heard before leaves them all black).
+        let all = crate::distributed::for_share(
             ranks,
             &mut centre,
             w * 4,
+            options.threads,
+            trace,
+            &mut |f| {
+                control(reporter.report(Progress {
+                    fraction: CENTRE_SHARE * f,
+                    ..base
+                }))
+            },
             |c: &(Vec3, u32)| [c.0.x, c.0.y, c.0.z, c.1 as f32].map(f64::from),
             |v| {
                 (
@@ -277,7 +270,7 @@ pub fn render_distributed(
                     v[3] as u32,
                 )
             },
-        )?;
+        )? && !reporter.stopped();
         stats.camera_rays = (w * h) as u64;
 
         // Edge pixels, refined with more rays.
@@ -294,31 +287,26 @@ pub fn render_distributed(
             );
             Ok(())
         };
-        let mine = crate::distributed::share_of(ranks, refined.len(), 64);
-        let all = all
-            && for_chunks_reporting(
-                &mut refined[mine.clone()],
-                64,
-                options.threads,
-                |first, out| refine(mine.start + first, out),
-                &mut |f| {
-                    control(reporter.report(Progress {
-                        fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,
-                        ..base
-                    }))
-                },
-            )?;
-        let all = !crate::distributed::any(ranks, !all)?;
-        crate::distributed::gather_shares(
+        // Each rank a run of the edge pixels (none after a Stop: `edges` is empty then).
+        let refined_all = crate::distributed::for_share(
             ranks,
             &mut refined,
             64,
+            options.threads,
+            refine,
+            &mut |f| {
+                control(reporter.report(Progress {
+                    fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,
+                    ..base
+                }))
+            },
             |r: &Option<Vec3>| match r {
                 Some(v) => [1.0, f64::from(v.x), f64::from(v.y), f64::from(v.z)],
                 None => [0.0; 4],
             },
             |v| (v[0] != 0.0).then(|| Vec3::new(v[1] as f32, v[2] as f32, v[3] as f32)),
         )?;
+        let all = all && refined_all;
         stats.camera_rays += (edges.first_ray.last().copied().unwrap_or(w * h) - w * h) as u64;
         stats.supersampled_pixels = refined.iter().filter(|r| r.is_some()).count() as u64;
         stats.interpolation_queries = crate::distributed::sum_over(ranks, queries.into_inner())?;

@@ -18,7 +18,7 @@ use rand_pcg::Pcg64Mcg;
 use super::poisson::side_seed;
 use super::{surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
 use crate::error::Result;
-use crate::parallel::{for_chunks, for_chunks_reporting, Report};
+use crate::parallel::{for_chunks, Report};
 use crate::progress::Control;
 use crate::visibility::Visibility;
 
@@ -106,18 +106,19 @@ pub fn errors(
         }
         Ok(())
     };
-    let mine = crate::distributed::share_of(ranks, n, 1024);
-    let all = for_chunks_reporting(
-        &mut out[mine.clone()],
+    let all = crate::distributed::for_share(
+        ranks,
+        &mut out,
         1024,
         threads,
-        |first, chunk| error(mine.start + first, chunk),
+        error,
         report,
+        |&e| [e],
+        |v| v[0],
     )?;
-    if crate::distributed::any(ranks, !all)? {
+    if !all {
         return Ok(None);
     }
-    crate::distributed::gather_shares(ranks, &mut out, 1024, |&e| [e], |v| v[0])?;
     Ok(Some(out))
 }
 
@@ -206,8 +207,6 @@ pub fn refine(
     let mut next: Vec<usize> = groups.iter().map(|g| g.start).collect();
     let mut thrown = 0u64;
     let shared: &Samples = samples;
-    // Over several ranks, each fills every size-th side's discs.
-    let (rank, size) = (ranks.rank(), ranks.size().max(1));
     loop {
         let pieces: Vec<std::ops::Range<usize>> = groups
             .iter()
@@ -228,7 +227,7 @@ pub fn refine(
         let mut work: Vec<(usize, &mut Vec<(Vec2, f32)>)> = placed.iter_mut().enumerate().collect();
         for_chunks(&mut work, 1, settings.threads, |_, out| {
             let (g, points) = &mut out[0];
-            if *g % size != rank {
+            if !crate::distributed::deals(ranks, *g) {
                 // Another rank's side.
                 return Ok(());
             }

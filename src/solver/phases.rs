@@ -81,10 +81,10 @@ impl Solve<'_> {
         let threads = self.options.threads.max(1);
         if !self.reporter.stopped() {
             let base = self.base(Phase::Sampling, 0, 0);
-            // Over several ranks, each places every size-th side.
-            let (rank, size) = (self.ranks.rank(), self.ranks.size().max(1));
+            // Over several ranks, each places the sides it deals.
+            let ranks = self.ranks;
             let place = |i: usize, out: &mut [Vec<glam::Vec2>]| {
-                if i % size != rank {
+                if !crate::distributed::deals(ranks, i) {
                     return Ok(());
                 }
                 let side = sides[i];

@@ -11,7 +11,6 @@ use glam::DVec3;
 use super::Solution;
 use crate::error::Result;
 use crate::light::Arrival;
-use crate::parallel::for_chunks;
 use crate::sampling::{is_back, surface_of, Samples};
 use crate::scene::Scene;
 use crate::visibility::Visibility;
@@ -61,10 +60,7 @@ pub(crate) fn start(
     // (irradiance, unshot, radiosity) of each new sample.
     let mut out = vec![(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); n - first_new];
     let shared: &Solution = solution;
-    let mine = crate::distributed::share_of(ranks, out.len(), 256);
-    let offset = mine.start;
-    for_chunks(&mut out[mine], 256, threads, |first, chunk| {
-        let first = offset + first;
+    let each = |first: usize, chunk: &mut [(DVec3, DVec3, DVec3)]| {
         let samples = &shared.samples;
         let mut near = Vec::new();
         let r = 2.0 * epsilon;
@@ -110,11 +106,15 @@ pub(crate) fn start(
             *o = (h, rho * h - shot, emission(scene, samples, k) + rho * h);
         }
         Ok(())
-    })?;
-    crate::distributed::gather_shares(
+    };
+    // Each rank a run of the new samples.
+    crate::distributed::for_share(
         ranks,
         &mut out,
         256,
+        threads,
+        each,
+        &mut |_| crate::progress::Control::Continue,
         |(h, u, b)| [h.x, h.y, h.z, u.x, u.y, u.z, b.x, b.y, b.z],
         |v| {
             (

@@ -34,7 +34,7 @@ use super::normalise::row_scale;
 use super::pipeline::with_pool;
 use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
-use crate::distributed::{gather_one, owners, Ranks};
+use crate::distributed::{gather_one, owners, sum_over, Ranks};
 use crate::error::Result;
 use crate::parallel::for_chunks;
 use crate::progress::Control;
@@ -137,10 +137,8 @@ pub(crate) fn shoot(
         let held = gather_one(ranks, stats.held_links as f64)?;
         stats.links = held.iter().sum::<f64>() as u64;
         stats.most_held_links = held.iter().fold(0.0f64, |a, &b| a.max(b)) as u64;
-        stats.leaf_links = gather_one(ranks, stats.leaf_links as f64)?
-            .iter()
-            .sum::<f64>() as u64;
-        stats.queries = gather_one(ranks, stats.queries as f64)?.iter().sum::<f64>() as u64;
+        stats.leaf_links = sum_over(ranks, stats.leaf_links)?;
+        stats.queries = sum_over(ranks, stats.queries)?;
     }
     let link_bytes: usize = all().map(Links::bytes).sum();
     if crate::distributed::any(ranks, flow.is_break())? {
@@ -208,7 +206,9 @@ fn link_groups(
     let pairs: Vec<(usize, usize)> = (0..roots.len())
         .flat_map(|x| (x..roots.len()).map(move |y| (x, y)))
         .collect();
-    let jobs: Vec<usize> = (me..pairs.len()).step_by(size).collect();
+    let jobs: Vec<usize> = (0..pairs.len())
+        .filter(|&j| crate::distributed::deals(ranks, j))
+        .collect();
     let link = |job: usize| {
         let (x, y) = pairs[job];
         linker.links_between(roots[x], roots[y])
