@@ -4,9 +4,10 @@
 //! grouped by their distance to the nearest ceiling–wall edge; each band's mean is divided by
 //! the reference's over the same pixels.
 //!
-//! `cargo run --release --example edge_bands -- SCENE.toml REFERENCE.exr` (the reference at the
-//! scene's image size, e.g. from `meshlight render SCENE.toml --method pathtrace`). The room is
-//! the scene's bounding box: ceiling at its top, walls at its four sides.
+//! `cargo run --release --example edge_bands -- SCENE.toml REFERENCE.exr [GATHER_RAYS]` (the
+//! reference at the scene's image size, e.g. from `meshlight render SCENE.toml --method
+//! pathtrace`; gather rays as `render --gather-rays`, default the library's). The room is the
+//! scene's bounding box: ceiling at its top, walls at its four sides.
 
 use meshlight::visibility::Ray;
 use meshlight::{Backend, Control, Image, Options, RenderOptions, Scene};
@@ -16,8 +17,10 @@ const BANDS: [f32; 6] = [0.0, 0.02, 0.05, 0.1, 0.2, 0.4];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let [scene, reference] = args.as_slice() else {
-        return Err("usage: edge_bands SCENE.toml REFERENCE.exr".into());
+    let (scene, reference, gather_rays) = match args.as_slice() {
+        [s, r] => (s, r, RenderOptions::default().gather_rays),
+        [s, r, g] => (s, r, g.parse()?),
+        _ => return Err("usage: edge_bands SCENE.toml REFERENCE.exr [GATHER_RAYS]".into()),
     };
     let scene = Scene::load(scene)?;
     let reference = Image::read_exr(std::path::Path::new(reference))?;
@@ -29,7 +32,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &scene,
         &solution,
         vis.as_ref(),
-        &RenderOptions::default(),
+        &RenderOptions {
+            gather_rays,
+            ..RenderOptions::default()
+        },
         &mut |_| Control::Continue,
     )?;
     if (image.width, image.height) != (reference.width, reference.height) {

@@ -155,6 +155,12 @@ pub struct RenderArgs {
     #[arg(long,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
     pub direct_rays: Option<u32>,
+    /// Meshless: rays gathered over the hemisphere at a camera hit within its samples' reach of
+    /// another surface (contacts, creases: exact visibility there); 0 interpolates there too
+    /// [default: the preset's: preview 0, default 64, final 256].
+    #[arg(long,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::render::MAX_GATHER_RAYS)))]
+    pub gather_rays: Option<u32>,
     /// Rays drawn from a glossy surface's lobe where a camera path meets one (and light samples
     /// per area light there).
     #[arg(long, default_value_t = 16,
@@ -199,7 +205,7 @@ pub struct SweepArgs {
     /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
     /// Keys: preset, epsilon, epsilon-scale, zeta, alpha, rounds, light-samples, tolerance, max-shots,
     /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
-    /// supersample, direct-rays, specular-depth, specular-rays, glossy-rays, patch-size, spp.
+    /// supersample, direct-rays, gather-rays, specular-depth, specular-rays, glossy-rays, patch-size, spp.
     #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
     pub vary: Vec<(String, Vec<String>)>,
     /// How each run computes its image.
@@ -214,6 +220,11 @@ pub struct SweepArgs {
     #[arg(long,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
     pub direct_rays: Option<u32>,
+    /// Meshless: rays gathered at a camera hit near another surface; 0 interpolates there too
+    /// [default: the preset's].
+    #[arg(long,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::render::MAX_GATHER_RAYS)))]
+    pub gather_rays: Option<u32>,
     /// Patches: the side of the square patches (default: the solver's ε).
     #[arg(long)]
     pub patch_size: Option<f32>,
@@ -418,12 +429,13 @@ pub fn backend_from(args: &Knobs) -> meshlight::Backend {
         .unwrap_or_else(meshlight::Backend::default_backend)
 }
 
-/// The render's settings from a preset and the command line: `supersample` and `direct_rays`
-/// where given, the preset's otherwise.
+/// The render's settings from a preset and the command line: `supersample`, `direct_rays` and
+/// `gather_rays` where given, the preset's otherwise.
 pub fn render_options_from(
     args: &Knobs,
     supersample: Option<u32>,
     direct_rays: Option<u32>,
+    gather_rays: Option<u32>,
 ) -> anyhow::Result<meshlight::RenderOptions> {
     let mut o = args
         .preset
@@ -431,6 +443,7 @@ pub fn render_options_from(
         .render_options();
     o.supersample = supersample.unwrap_or(o.supersample).max(1);
     o.direct = direct_rays.map_or(o.direct, meshlight::Direct::from_rays);
+    o.gather_rays = gather_rays.unwrap_or(o.gather_rays);
     Ok(o)
 }
 

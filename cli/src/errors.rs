@@ -19,7 +19,8 @@ pub fn explain(e: &anyhow::Error) -> String {
 
 /// The command-line flag of a library option, where there is one.
 fn flag(option: &str) -> Option<String> {
-    const FLAGS: [(&str, &str); 19] = [
+    const FLAGS: [(&str, &str); 20] = [
+        ("gather_rays", "--gather-rays"),
         ("specular_rays", "--specular-rays"),
         ("specular_depth", "--specular-depth"),
         ("glossy_rays", "--glossy-rays"),

@@ -218,7 +218,8 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         }
         Method::Meshless => {
             let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
-            let preset = render_options_from(&r.solve.knobs, r.supersample, r.direct_rays)?;
+            let preset =
+                render_options_from(&r.solve.knobs, r.supersample, r.direct_rays, r.gather_rays)?;
             let render_options = meshlight::RenderOptions {
                 threads: options.threads,
                 supersample: preset.supersample,
@@ -228,6 +229,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
                     _ => meshlight::Quantity::Radiance,
                 },
                 glossy_rays: r.glossy_rays,
+                gather_rays: preset.gather_rays,
                 memory_budget: options.memory_budget,
             };
             let t = std::time::Instant::now();

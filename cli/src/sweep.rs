@@ -36,6 +36,7 @@ const KEYS: &[&str] = &[
     "seed",
     "supersample",
     "direct-rays",
+    "gather-rays",
     "specular-depth",
     "specular-rays",
     "glossy-rays",
@@ -62,6 +63,8 @@ pub struct Sweep {
     /// Meshless: shadow rays per area light at each camera hit (0: interpolated direct light);
     /// `None`: the preset's.
     pub direct_rays: Option<u32>,
+    /// Meshless: gather rays at hits near another surface; `None`: the preset's.
+    pub gather_rays: Option<u32>,
     /// Patch side (patches; default the solver's ε).
     pub patch_size: Option<f32>,
     /// Samples per pixel (pathtrace).
@@ -87,6 +90,7 @@ impl From<crate::SweepArgs> for Sweep {
             knobs: a.solve.knobs,
             supersample: a.supersample,
             direct_rays: a.direct_rays,
+            gather_rays: a.gather_rays,
             patch_size: a.patch_size,
             spp: a.spp,
             out: a.out,
@@ -148,6 +152,8 @@ struct Extra {
     supersample: u32,
     /// Shadow rays per area light at each camera hit (0: direct light interpolated).
     direct_rays: u32,
+    /// Gather rays at hits near another surface (0: none).
+    gather_rays: u32,
     /// Rays drawn from a glossy lobe where a camera path meets one.
     glossy_rays: u32,
     patch_size: Option<f32>,
@@ -185,6 +191,7 @@ fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
         "seed" => o.seed = value(key, v)?,
         "supersample" => extra.supersample = value::<u32>(key, v)?.max(1),
         "direct-rays" => extra.direct_rays = value(key, v)?,
+        "gather-rays" => extra.gather_rays = value(key, v)?,
         "specular-depth" => o.specular_depth = value(key, v)?,
         "specular-rays" => o.specular_rays = value(key, v)?,
         "glossy-rays" => extra.glossy_rays = value(key, v)?,
@@ -262,13 +269,19 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             }
         }
         let mut options = super::options_from(sweep.epsilon, &knobs)?;
-        let render = super::render_options_from(&knobs, sweep.supersample, sweep.direct_rays)?;
+        let render = super::render_options_from(
+            &knobs,
+            sweep.supersample,
+            sweep.direct_rays,
+            sweep.gather_rays,
+        )?;
         let mut extra = Extra {
             supersample: render.supersample,
             direct_rays: match render.direct {
                 meshlight::Direct::Interpolated => 0,
                 meshlight::Direct::Traced { light_samples } => light_samples,
             },
+            gather_rays: render.gather_rays,
             glossy_rays: meshlight::RenderOptions::default().glossy_rays,
             patch_size: sweep.patch_size,
             spp: sweep.spp,
@@ -337,6 +350,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             let extra = Extra {
                 supersample: 1,
                 direct_rays: 0,
+                gather_rays: 0,
                 glossy_rays: 0,
                 patch_size: None,
                 spp,
@@ -451,6 +465,7 @@ fn measure(
                         threads: options.threads,
                         supersample: extra.supersample,
                         direct: meshlight::Direct::from_rays(extra.direct_rays),
+                        gather_rays: extra.gather_rays,
                         glossy_rays: extra.glossy_rays,
                         ..meshlight::RenderOptions::default()
                     },

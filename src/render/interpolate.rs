@@ -38,6 +38,8 @@ pub(crate) struct Interpolator<'a> {
     /// Whether weights are those of a local-linear fit (see [`local_linear`]); plain kernel
     /// weights (all positive) where they enter the solve as transport.
     linear: bool,
+    /// Whether each sample must be in sight of the point (see [`Interpolator::blind`]).
+    sight: bool,
 }
 
 impl<'a> Interpolator<'a> {
@@ -53,6 +55,7 @@ impl<'a> Interpolator<'a> {
             lift: crate::visibility::lift(scene),
             support,
             linear: true,
+            sight: true,
         }
     }
 
@@ -60,6 +63,19 @@ impl<'a> Interpolator<'a> {
     /// the solve, where a negative entry could create light.
     pub(crate) fn plain(mut self) -> Self {
         self.linear = false;
+        self
+    }
+
+    /// The samples interpolated.
+    pub(crate) fn samples(&self) -> &crate::sampling::Samples {
+        &self.solution.samples
+    }
+
+    /// The same, without asking whether each sample is in sight, in the index's order: for
+    /// the many points a final gather reads, each a small share of its answer, where the
+    /// queries would cost more than the rest of the render.
+    pub(crate) fn blind(mut self) -> Self {
+        self.sight = false;
         self
     }
 
@@ -80,7 +96,7 @@ impl<'a> Interpolator<'a> {
     }
 
     /// The samples each site interpolates, with their kernel weights (not normalised), in
-    /// sample order; or its nearest visible sample (weight 1); or none when it is sealed off
+    /// sample order (but see [`Interpolator::blind`]); or its nearest visible sample (weight 1); or none when it is sealed off
     /// from them all. Returns the visibility queries.
     pub(crate) fn weights(&self, sites: &[Site], out: &mut Vec<Vec<(u32, f32)>>) -> Result<u64> {
         let s = &self.solution.samples;
@@ -96,9 +112,13 @@ impl<'a> Interpolator<'a> {
             self.solution
                 .index
                 .within(s, site.side, uv, reach, &mut near);
-            near.sort_unstable_by_key(|&(k, _)| k);
+            // In sample order, as documented; a gather's points skip it (the index's order is
+            // as deterministic, and they are many).
+            if self.sight {
+                near.sort_unstable_by_key(|&(k, _)| k);
+            }
             let start = candidates.len();
-            let test = self.solution.obstruction.is_obstructed(site.side);
+            let test = self.sight && self.solution.obstruction.is_obstructed(site.side);
             for &(k, d2) in &near {
                 let r = SUPPORT * s.radius[k as usize];
                 let q = d2 / (r * r);

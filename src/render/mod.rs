@@ -8,6 +8,7 @@
 //! and a jittered grid of rays where the pixel or a neighbour sees another surface side, finer
 //! where the edge's contrast is high.
 
+mod gather;
 pub(crate) mod image;
 pub(crate) mod interpolate;
 mod paths;
@@ -21,6 +22,7 @@ use crate::sampling::{side_of, surface_of, Side};
 use crate::scene::Scene;
 use crate::solver::Solution;
 use crate::visibility::{Hit, Ray, Visibility};
+pub use gather::MAX_GATHER_RAYS;
 pub use image::Image;
 use interpolate::{Interpolator, Site};
 
@@ -42,6 +44,11 @@ pub struct RenderOptions {
     /// samples per area light there), 1 to [`MAX_GLOSSY_RAYS`]: more gives smoother glossy
     /// reflections at proportional cost. Unused in scenes without glossy surfaces.
     pub glossy_rays: u32,
+    /// Rays gathered over the hemisphere at a hit within its samples' reach of another surface
+    /// (contacts, creases), 0 to [`MAX_GATHER_RAYS`]; 0 interpolates there as everywhere.
+    /// More: less noise along contacts and creases at proportional cost there. Scenes with
+    /// specular surfaces interpolate.
+    pub gather_rays: u32,
     /// The memory budget, bytes: an image whose working arrays would not fit
     /// ([`BYTES_PER_PIXEL`](crate::budget::BYTES_PER_PIXEL) a pixel) is refused before they are
     /// allocated.
@@ -99,17 +106,19 @@ impl Default for RenderOptions {
             quantity: Quantity::Radiance,
             direct: Direct::Traced { light_samples: 16 },
             glossy_rays: 16,
+            gather_rays: DEFAULT_GATHER_RAYS,
             memory_budget: crate::budget::DEFAULT_MEMORY_BUDGET,
         }
     }
 }
 
 impl RenderOptions {
-    /// Fast and rough: fewer shadow rays at the hits and fewer rays on edges
-    /// ([`crate::Preset::Preview`]).
+    /// Fast and rough: fewer shadow rays at the hits, fewer rays on edges, no gather at
+    /// contacts and creases ([`crate::Preset::Preview`]).
     pub fn preview() -> Self {
         RenderOptions {
             supersample: PREVIEW_SUPERSAMPLE,
+            gather_rays: 0,
             direct: Direct::Traced {
                 light_samples: PREVIEW_DIRECT_RAYS,
             },
@@ -117,11 +126,12 @@ impl RenderOptions {
         }
     }
 
-    /// Slower and finer: more shadow rays at the hits and more rays on edges
-    /// ([`crate::Preset::Final`]).
+    /// Slower and finer: more shadow rays at the hits, more rays on edges and in the gathers at
+    /// contacts and creases ([`crate::Preset::Final`]).
     pub fn final_quality() -> Self {
         RenderOptions {
             supersample: FINAL_SUPERSAMPLE,
+            gather_rays: FINAL_GATHER_RAYS,
             direct: Direct::Traced {
                 light_samples: FINAL_DIRECT_RAYS,
             },
@@ -130,10 +140,13 @@ impl RenderOptions {
     }
 }
 
+/// Gather rays per hit near another surface, by default.
+pub const DEFAULT_GATHER_RAYS: u32 = 32;
 const PREVIEW_SUPERSAMPLE: u32 = 2;
 const PREVIEW_DIRECT_RAYS: u32 = 4;
 const FINAL_SUPERSAMPLE: u32 = 8;
 const FINAL_DIRECT_RAYS: u32 = 64;
+const FINAL_GATHER_RAYS: u32 = 128;
 
 /// What rendering did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -213,6 +226,15 @@ pub fn render_distributed(
                 ),
             ));
         }
+        if options.gather_rays > MAX_GATHER_RAYS {
+            return Err(crate::Error::argument(
+                "gather_rays",
+                format!(
+                    "{} gather rays per hit: must lie in 0..={MAX_GATHER_RAYS}",
+                    options.gather_rays
+                ),
+            ));
+        }
         if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
             return Err(crate::Error::argument(
                 "supersample",
@@ -245,7 +267,7 @@ pub fn render_distributed(
                 .map(|p| camera_ray(scene, (p % w) as f32 + 0.5, (p / w) as f32 + 0.5))
                 .collect();
             queries.fetch_add(
-                shader.shade(&rays, first as u32, out)?,
+                shader.shade(&rays, first as u32, out, 1)?,
                 std::sync::atomic::Ordering::Relaxed,
             );
             Ok(())
@@ -431,7 +453,14 @@ impl Edges {
             }
         }
         let mut shaded = vec![(Vec3::ZERO, 0u32); rays.len()];
-        let queries = shader.shade(&rays, self.first_ray[first] as u32, &mut shaded)?;
+        // A pixel's rays share its gather (the grid averages their answers); the largest
+        // grid of the batch sets the share.
+        let n = self.per_side[first..first + out.len()]
+            .iter()
+            .max()
+            .copied()
+            .unwrap_or(1) as u32;
+        let queries = shader.shade(&rays, self.first_ray[first] as u32, &mut shaded, n * n)?;
         let mut rest = &shaded[..];
         for (o, &n) in out.iter_mut().zip(&self.per_side[first..]) {
             let (group, tail) = rest.split_at(n * n);
@@ -467,12 +496,20 @@ struct Shader<'a> {
     scene: &'a Scene,
     vis: &'a dyn Visibility,
     interpolator: Interpolator<'a>,
+    /// The same for the points gathers read ([`Interpolator::blind`]).
+    blind: Interpolator<'a>,
     /// What the pixels hold.
     quantity: Quantity,
     /// What each sample shows (see [`Shader::new`]), computed once: hits ask for it many times.
     values: Vec<glam::DVec3>,
     /// What each sample shows with its direct light (for hits whose direct light is not traced).
     full: Vec<glam::DVec3>,
+    /// What a gather ray sees of each sample: the direct light and the inter-reflected light
+    /// it reflects, per unit reflectance and over π (its emission is direct light, traced at
+    /// the hits). Empty when nothing gathers.
+    outgoing: Vec<(glam::DVec3, glam::DVec3)>,
+    /// Gather rays per pixel.
+    gather_rays: u32,
     /// Direct light traced at the hits, when the pixels take theirs from there.
     light: Option<DirectLight>,
     /// The same with [`PENUMBRA_RAYS`] times the rays, for hits in a penumbra.
@@ -557,6 +594,33 @@ impl<'a> Shader<'a> {
             })
             .collect();
         let full = (0..s.len()).map(|k| shown(k, glam::DVec3::ZERO)).collect();
+        let gathers = options.gather_rays > 0
+            && light.is_some()
+            && !crate::specular::Specular::of(scene).any();
+        let outgoing = if gathers {
+            (0..s.len())
+                .map(|k| {
+                    // Per unit reflectance: each gather hit multiplies by its own.
+                    let rho = crate::solver::reflectance_of(scene, s, k);
+                    let direct = solution.direct[k].irradiance;
+                    let reflected = solution.radiosity[k]
+                        - crate::solver::emission_of(scene, s, k)
+                        - rho * direct;
+                    let ratio = |b: f64, rho: f64| if rho > 0.0 { b / rho } else { 0.0 };
+                    let per_unit = glam::DVec3::new(
+                        ratio(reflected.x, rho.x),
+                        ratio(reflected.y, rho.y),
+                        ratio(reflected.z, rho.z),
+                    );
+                    (
+                        direct / std::f64::consts::PI,
+                        per_unit / std::f64::consts::PI,
+                    )
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let penumbra = match options.direct {
             Direct::Traced { light_samples } if light.is_some() => {
                 Some(DirectLight::with_specular(
@@ -571,9 +635,12 @@ impl<'a> Shader<'a> {
             scene,
             vis,
             interpolator: Interpolator::new(scene, solution, vis),
+            blind: Interpolator::new(scene, solution, vis).blind(),
             quantity: options.quantity,
             values,
             full,
+            outgoing,
+            gather_rays: options.gather_rays,
             light,
             penumbra,
             paths: {
@@ -600,7 +667,15 @@ impl<'a> Shader<'a> {
 
     /// Shades a batch of rays: (radiance, side seen or u32::MAX). Ray i seeds its shadow rays
     /// with id `first_id + i`. Returns visibility queries.
-    fn shade(&self, rays: &[Ray], first_id: u32, out: &mut [(Vec3, u32)]) -> Result<u64> {
+    /// Hits near another surface gather light (see [`gather`]), `share` rays of a pixel
+    /// sharing its gather.
+    fn shade(
+        &self,
+        rays: &[Ray],
+        first_id: u32,
+        out: &mut [(Vec3, u32)],
+        share: u32,
+    ) -> Result<u64> {
         if let Some(paths) = &self.paths {
             return self.shade_paths(paths, rays, first_id, out);
         }
@@ -653,7 +728,7 @@ impl<'a> Shader<'a> {
                 id: first_id.wrapping_add(pending.len() as u32),
             });
         }
-        let (radiance, queries) = self.resolve(&pending)?;
+        let (radiance, queries) = self.resolve(&pending, share)?;
         for ((p, o), radiance) in pending.iter().zip(out.iter_mut()).zip(radiance) {
             *o = (radiance, p.side);
         }
@@ -661,8 +736,10 @@ impl<'a> Shader<'a> {
     }
 
     /// The radiance (or irradiance) each pending hit shows: its fixed value, or its samples
-    /// interpolated plus its direct light traced. Returns the visibility queries too.
-    fn resolve(&self, pending: &[Pending]) -> Result<(Vec<Vec3>, u64)> {
+    /// interpolated plus its direct light traced; hits near another surface whose direct light
+    /// is traced blend in the light gathered there, `share` hits of a pixel sharing its
+    /// gather (0: none gathers). Returns the visibility queries too.
+    fn resolve(&self, pending: &[Pending], share: u32) -> Result<(Vec<Vec3>, u64)> {
         // Whether each hit that is interpolated is covered, asked in one batch.
         let lit: Vec<usize> = (0..pending.len())
             .filter(|&i| pending[i].fixed.is_none())
@@ -683,7 +760,17 @@ impl<'a> Shader<'a> {
             })
             .collect();
         let mut weights = Vec::new();
-        let queries = self.interpolator.weights(&sites, &mut weights)? + covered.len() as u64;
+        let mut queries = self.interpolator.weights(&sites, &mut weights)? + covered.len() as u64;
+        let gathering = share > 0 && !self.outgoing.is_empty();
+        let gathered: Vec<(&Pending, f32)> = lit
+            .iter()
+            .zip(&weights)
+            .filter(|&(&i, _)| gathering && pending[i].traced)
+            .map(|(&i, chosen)| (&pending[i], self.reach(chosen)))
+            .collect();
+        let (gathered, q) = self.gather(&gathered, share)?;
+        queries += q;
+        let mut gathered = gathered.into_iter();
         let direct = self.direct_at(pending)?;
         self.shadow_rays
             .fetch_add(direct.1, std::sync::atomic::Ordering::Relaxed);
@@ -706,11 +793,18 @@ impl<'a> Shader<'a> {
                         sum += f64::from(w) * values[k as usize];
                     }
                     // A local-linear fit may extrapolate below zero near a dark edge.
-                    let interpolated = if wsum > 0.0 {
+                    let mut interpolated = if wsum > 0.0 {
                         (sum / wsum).as_vec3().max(Vec3::ZERO)
                     } else {
                         Vec3::ZERO
                     };
+                    if gathering && p.traced {
+                        let g = gathered.next().expect("one per traced interpolated hit");
+                        if g.alpha > 0.0 {
+                            let shown = self.shown_gathered(p, g.irradiance);
+                            interpolated += g.alpha * (shown - interpolated);
+                        }
+                    }
                     match p.texel {
                         Some(rho) if self.quantity == Quantity::Radiance => {
                             let material = self.scene.material_of(surface_of(p.side));
@@ -727,6 +821,43 @@ impl<'a> Shader<'a> {
             });
         }
         Ok((out, queries))
+    }
+
+    /// How far a hit's interpolation reaches: its samples' kernel support (twice their mean
+    /// radius). A surface nearer than that changes the light within the kernels.
+    fn reach(&self, chosen: &[(u32, f32)]) -> f32 {
+        let radius = &self.interpolator.samples().radius;
+        let (mut wsum, mut sum) = (0.0f32, 0.0f32);
+        for &(k, w) in chosen {
+            wsum += w.abs();
+            sum += w.abs() * radius[k as usize];
+        }
+        if wsum > 0.0 {
+            interpolate::SUPPORT * sum / wsum
+        } else {
+            0.0
+        }
+    }
+
+    /// What a hit shows of the inter-reflected irradiance gathered there, as its interpolated
+    /// value would: reflected radiance, per unit reflectance on a textured surface, or the
+    /// irradiance itself.
+    fn shown_gathered(&self, p: &Pending, irradiance: glam::DVec3) -> Vec3 {
+        let e = irradiance.as_vec3();
+        match self.quantity {
+            Quantity::Irradiance => e,
+            Quantity::Radiance if p.texel.is_some() => e / std::f32::consts::PI,
+            Quantity::Radiance => {
+                // Its samples show their emission too (a luminous ceiling's crease).
+                let material = self.scene.material_of(surface_of(p.side));
+                let emitted = if crate::sampling::is_back(p.side) {
+                    Vec3::ZERO
+                } else {
+                    material.ke
+                };
+                material.kd * e / std::f32::consts::PI + emitted
+            }
+        }
     }
 
     /// The direct light each interpolated hit shows, traced there (zero where the pixels take it

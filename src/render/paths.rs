@@ -222,7 +222,7 @@ impl Shader<'_> {
         }
         queries += self.light_samples_seen(paths, &shadowed, &mut radiance)?;
         let pending: Vec<Pending> = ends.iter().map(|(p, _, _)| p.clone()).collect();
-        let (shown, q) = self.resolve(&pending)?;
+        let (shown, q) = self.resolve(&pending, 0)?;
         queries += q;
         for ((_, origin, weight), value) in ends.iter().zip(shown) {
             radiance[*origin] += *weight * value.as_dvec3();

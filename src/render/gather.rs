@@ -1,0 +1,324 @@
+//! A final gather where another surface is near (`docs/method.md` §18, "Contacts and
+//! creases"): where surfaces meet (a box on a floor, a wall under a ceiling) the inter-reflected
+//! light falls off within centimetres, finer than the samples, each of which stands for its
+//! region's average. At a camera hit with another surface within its samples' kernels, the
+//! inter-reflected irradiance is therefore gathered there: rays over the hemisphere, each
+//! reading the light its hit reflects from the samples there. Visibility at the hit itself is
+//! then exact, which is what the crease is made of. Hits of the gather near the crease gather
+//! in turn with fewer rays (their interpolated light is as wrong as the first hit's). The
+//! gather is blended with the interpolated value by how much of the hemisphere the near
+//! surfaces fill, so it fades out smoothly away from them and costs nothing on open surfaces.
+
+use glam::{DVec3, Vec3};
+
+use super::interpolate::Site;
+use super::{Pending, Shader};
+use crate::error::Result;
+use crate::sampling::side_of;
+use crate::visibility::{Hit, Ray, Segment};
+
+/// Short rays that find whether a pixel's hit has another surface near it.
+const PROBES: u32 = 8;
+/// The fewest probes a hit gets when a pixel's rays share them.
+const MIN_SHARED_PROBES: u32 = 2;
+/// The fewest gather rays a hit near another surface gets when a pixel's rays share them.
+const MIN_SHARED_RAYS: u32 = 4;
+
+/// The most gather rays per hit.
+pub const MAX_GATHER_RAYS: u32 = 4096;
+
+/// Seeds of the probes' and the gather's rotations.
+const PROBE_SEED: u64 = 0x7072_6f62_6573_2121;
+const GATHER_SEED: u64 = 0x6761_7468_6572_2121;
+
+/// A hit's gathered inter-reflected light and how much of it replaces the interpolated one.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Gathered {
+    /// Weight of the gathered light, 0 to 1: twice the share of the (cosine-weighted)
+    /// hemisphere whose rays hit a surface within the reach, so 1 at a contact line and 0 where
+    /// nothing is within the reach.
+    pub alpha: f32,
+    /// Inter-reflected irradiance gathered (without the direct light, traced apart).
+    pub irradiance: DVec3,
+}
+
+/// A point to gather at.
+struct Spot {
+    point: Vec3,
+    normal: Vec3,
+    /// How far its interpolation reaches: surfaces nearer than this are near.
+    reach: f32,
+    seed: u64,
+}
+
+/// Levels of gathering: the hits of a gather near its point lie near the crease too, where
+/// their interpolated light is as wrong as the point's, so they gather in turn, with
+/// [`NEXT_RAYS`] rays each (their noise averages out over the many near hits of a gather, and
+/// the cost stays proportional to the first level's rays); the next level's hits are
+/// interpolated.
+const LEVELS: u32 = 2;
+const NEXT_RAYS: u32 = 4;
+
+/// Spots gathered at once: bounds the memory of a batch of rays whatever the image's width.
+const SPOTS_AT_ONCE: usize = 256;
+
+impl Shader<'_> {
+    /// For each hit that gets its direct light traced, with the reach it is interpolated over
+    /// (its samples' kernel support): the light gathered there, or the default (α 0) where no
+    /// surface is within the reach or the gather is off. `share` hits of a pixel share its
+    /// probes and gather rays (a grid averages its hits' answers). Returns the visibility
+    /// queries made.
+    pub(super) fn gather(
+        &self,
+        hits: &[(&Pending, f32)],
+        share: u32,
+    ) -> Result<(Vec<Gathered>, u64)> {
+        let mut out = vec![Gathered::default(); hits.len()];
+        if self.gather_rays == 0 || share == 0 || hits.is_empty() {
+            return Ok((out, 0));
+        }
+        let rays = (self.gather_rays / share).max(MIN_SHARED_RAYS);
+        let per_hit = (PROBES / share).max(MIN_SHARED_PROBES);
+        // Which hits have a surface within their reach.
+        let probes: Vec<Segment> = hits
+            .iter()
+            .flat_map(|&(p, reach)| {
+                let from = p.point + self.lift * p.normal;
+                directions(p.normal, per_hit, seed(PROBE_SEED, u64::from(p.id))).map(move |d| {
+                    Segment {
+                        a: from,
+                        b: from + reach * d,
+                    }
+                })
+            })
+            .collect();
+        let mut blocked = vec![false; probes.len()];
+        self.vis.occluded(&probes, &mut blocked)?;
+        let near: Vec<usize> = (0..hits.len())
+            .filter(|&i| {
+                let k = per_hit as usize;
+                blocked[i * k..(i + 1) * k].contains(&true)
+            })
+            .collect();
+        let spots: Vec<Spot> = near
+            .iter()
+            .map(|&i| Spot {
+                point: hits[i].0.point,
+                normal: hits[i].0.normal,
+                reach: hits[i].1,
+                seed: seed(GATHER_SEED, u64::from(hits[i].0.id)),
+            })
+            .collect();
+        let mut queries = probes.len() as u64;
+        for (near, spots) in near.chunks(SPOTS_AT_ONCE).zip(spots.chunks(SPOTS_AT_ONCE)) {
+            let (gathered, q) = self.gather_at(spots, rays, LEVELS - 1)?;
+            queries += q;
+            for (&i, g) in near.iter().zip(gathered) {
+                out[i] = g;
+            }
+        }
+        Ok((out, queries))
+    }
+
+    /// Gathers `rays` rays at each spot; hits within a spot's reach gather in turn while
+    /// `levels` remain.
+    fn gather_at(&self, spots: &[Spot], rays: u32, levels: u32) -> Result<(Vec<Gathered>, u64)> {
+        if spots.is_empty() {
+            return Ok((Vec::new(), 0));
+        }
+        let n = rays as usize;
+        let casts: Vec<Ray> = spots
+            .iter()
+            .flat_map(|spot| {
+                let from = spot.point + self.lift * spot.normal;
+                directions(spot.normal, rays, spot.seed).map(move |dir| Ray {
+                    origin: from,
+                    dir,
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                })
+            })
+            .collect();
+        let mut found = vec![None; casts.len()];
+        self.vis.intersect(&casts, &mut found)?;
+        let mut queries = casts.len() as u64;
+        let mut sites = Vec::new();
+        // The reflectance at each site: its texel, or its material's.
+        let mut reflectance = Vec::new();
+        // Per gather ray: its site's index, if its hit reflects sampled light.
+        let mut site_of = vec![None; casts.len()];
+        for (j, (ray, hit)) in casts.iter().zip(&found).enumerate() {
+            let Some(Hit { t, triangle }) = *hit else {
+                continue;
+            };
+            let tri = &self.scene.triangles[triangle as usize];
+            let back = ray.dir.dot(tri.normal) > 0.0;
+            let side = side_of(tri.surface, back);
+            if !self.interpolator.has_samples(side) {
+                continue;
+            }
+            let point = ray.origin + t * ray.dir;
+            site_of[j] = Some(sites.len());
+            sites.push(Site {
+                point,
+                side,
+                normal: if back { -tri.normal } else { tri.normal },
+                covered: false,
+            });
+            let rho = self
+                .texel(triangle, point)
+                .unwrap_or_else(|| self.scene.material_of(tri.surface).kd);
+            reflectance.push(rho.as_dvec3());
+        }
+        let mut weights = Vec::new();
+        queries += self.blind.weights(&sites, &mut weights)?;
+        // Each site's direct and inter-reflected light per unit reflectance, interpolated.
+        let parts: Vec<(DVec3, DVec3)> = weights
+            .iter()
+            .map(|chosen| {
+                let (mut wsum, mut direct, mut reflected) = (0.0f64, DVec3::ZERO, DVec3::ZERO);
+                for &(k, w) in chosen {
+                    let w = f64::from(w);
+                    wsum += w;
+                    direct += w * self.outgoing[k as usize].0;
+                    reflected += w * self.outgoing[k as usize].1;
+                }
+                if wsum > 0.0 {
+                    (
+                        (direct / wsum).max(DVec3::ZERO),
+                        (reflected / wsum).max(DVec3::ZERO),
+                    )
+                } else {
+                    (DVec3::ZERO, DVec3::ZERO)
+                }
+            })
+            .collect();
+
+        // Sites within their spot's reach gather in turn.
+        let mut next = Vec::new();
+        let mut next_of = vec![None; sites.len()];
+        if levels > 0 {
+            for (j, found) in found.iter().enumerate() {
+                let (Some(s), Some(hit)) = (site_of[j], found) else {
+                    continue;
+                };
+                if hit.t < spots[j / n].reach {
+                    next_of[s] = Some(next.len());
+                    next.push(Spot {
+                        point: sites[s].point,
+                        normal: sites[s].normal,
+                        reach: self.reach(&weights[s]),
+                        seed: seed(spots[j / n].seed, j as u64),
+                    });
+                }
+            }
+        }
+        let (again, q) = self.gather_at(&next, NEXT_RAYS, levels.saturating_sub(1))?;
+        queries += q;
+
+        let out = spots
+            .iter()
+            .enumerate()
+            .map(|(i, spot)| {
+                let (mut radiance, mut close) = (DVec3::ZERO, 0usize);
+                for j in i * n..(i + 1) * n {
+                    if let Some(s) = site_of[j] {
+                        let (direct, mut reflected) = parts[s];
+                        if let Some(g) = next_of[s].map(|m| again[m]) {
+                            let gathered = g.irradiance / std::f64::consts::PI;
+                            reflected += f64::from(g.alpha) * (gathered - reflected);
+                        }
+                        radiance += reflectance[s] * (direct + reflected);
+                    }
+                    if found[j].is_some_and(|h| h.t < spot.reach) {
+                        close += 1;
+                    }
+                }
+                // Cosine-weighted directions: the irradiance is π times the mean radiance.
+                Gathered {
+                    alpha: (2.0 * close as f32 / n as f32).min(1.0),
+                    irradiance: radiance * std::f64::consts::PI / n as f64,
+                }
+            })
+            .collect();
+        Ok((out, queries))
+    }
+}
+
+/// A hit's own seed: the same rays whatever the thread or rank that shades it.
+fn seed(base: u64, id: u64) -> u64 {
+    let mut z = base ^ id.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// `count` cosine-weighted directions about `normal`, stratified (a Hammersley set, shifted
+/// by the seed as a whole): a gather of a few dozen rays then sees a smooth field with far
+/// less noise than independent directions would.
+fn directions(normal: Vec3, count: u32, seed: u64) -> impl Iterator<Item = Vec3> {
+    let (a, b) = normal.any_orthonormal_pair();
+    let shift = (
+        (seed >> 40) as f32 / (1u64 << 24) as f32,
+        ((seed >> 16) & 0xff_ffff) as f32 / (1u64 << 24) as f32,
+    );
+    (0..count).map(move |i| {
+        let u1 = ((i as f32 + 0.5) / count as f32 + shift.0).fract();
+        let u2 = (radical_inverse(i) + shift.1).fract();
+        let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+        (a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt())
+            .normalize()
+    })
+}
+
+/// The base-2 radical inverse of i, in [0, 1).
+fn radical_inverse(i: u32) -> f32 {
+    (i.reverse_bits() as f64 / 4_294_967_296.0) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directions_are_cosine_weighted() {
+        // Over a cosine-weighted hemisphere the mean of cos θ is 2/3 and of cos² θ 1/2; the
+        // mean of each tangent component is 0.
+        let n = Vec3::new(0.3, -0.5, 0.8).normalize();
+        let (a, _) = n.any_orthonormal_pair();
+        let count = 1024;
+        let (mut c1, mut c2, mut t) = (0.0f64, 0.0f64, 0.0f64);
+        for d in directions(n, count, seed(7, 3)) {
+            assert!((d.length() - 1.0).abs() < 1e-5);
+            let c = f64::from(d.dot(n));
+            assert!(c >= 0.0);
+            c1 += c;
+            c2 += c * c;
+            t += f64::from(d.dot(a));
+        }
+        let m = f64::from(count);
+        assert!((c1 / m - 2.0 / 3.0).abs() < 2e-3, "{}", c1 / m);
+        assert!((c2 / m - 0.5).abs() < 2e-3, "{}", c2 / m);
+        assert!((t / m).abs() < 5e-3, "{}", t / m);
+    }
+
+    #[test]
+    fn a_wall_at_its_foot_fills_half_the_hemisphere() {
+        // From a point on a wall at height h above a floor, the floor is within reach R along
+        // the cosine-weighted directions whose disk coordinate toward the floor exceeds h/R:
+        // a segment of the unit disk, (acos c - c sqrt(1 - c^2)) / π with c = h/R.
+        let n = Vec3::X;
+        for c in [0.0f64, 0.25, 0.5, 0.75] {
+            let expected = (c.acos() - c * (1.0 - c * c).sqrt()) / std::f64::consts::PI;
+            let count = 4096;
+            let close = directions(n, count, seed(1, 2))
+                .filter(|d| f64::from(-d.y) > c)
+                .count();
+            let share = close as f64 / f64::from(count);
+            assert!(
+                (share - expected).abs() < 0.01,
+                "c {c}: {share} vs {expected}"
+            );
+        }
+    }
+}

@@ -1,0 +1,198 @@
+//! Contacts and creases against the path tracer: where surfaces meet, the inter-reflected
+//! light falls off within centimetres, finer than the samples (each stands for its region's
+//! average), so interpolation alone reads it several per cent too bright. The render gathers
+//! the light at hits near another surface; these tests measure bands a few centimetres wide
+//! along a box's foot and along a room's ceiling–wall edge, and check that interpolation alone
+//! misses them (the tests would fail without the gather).
+
+mod common;
+
+use common::{backends, camera, material, shipped, Builder};
+use glam::Vec3;
+use meshlight::reference::{path_trace, PathOptions};
+use meshlight::visibility::{Ray, Visibility};
+use meshlight::{Control, Image, Options, RenderOptions, Scene};
+
+/// The box on the floor: [BOX_LO, BOX_HI].
+const BOX_LO: Vec3 = Vec3::new(1.6, 0.0, 1.6);
+const BOX_HI: Vec3 = Vec3::new(2.4, 0.6, 2.4);
+/// The bands' width, metres.
+const BAND: f32 = 0.05;
+
+/// A 4 × 3 × 4 m white room, a square light under the ceiling over a white box that stands on
+/// the floor (its sides lit by the room); the camera looks at the box's front face and the
+/// floor before it.
+fn box_on_floor() -> Scene {
+    let mut b = Builder::default();
+    let white = b.material(material("white", 0.7, 0.0));
+    let light = b.material(material("light", 0.0, 10.0));
+    b.room(Vec3::ZERO, Vec3::new(4.0, 3.0, 4.0), white, &[]);
+    b.solid(BOX_LO, BOX_HI, white);
+    let y = 2.99;
+    let (x0, x1, z0, z1) = (1.5, 2.5, 1.5, 2.5);
+    b.quad(
+        [
+            Vec3::new(x0, y, z0),
+            Vec3::new(x1, y, z0),
+            Vec3::new(x1, y, z1),
+            Vec3::new(x0, y, z1),
+        ],
+        light,
+    );
+    b.scene(camera(
+        Vec3::new(2.0, 0.5, 0.9),
+        Vec3::new(2.0, 0.05, 1.6),
+        96,
+    ))
+}
+
+/// The point each pixel's centre ray sees.
+fn seen(scene: &Scene, vis: &dyn Visibility) -> Vec<Option<Vec3>> {
+    let c = scene.camera();
+    let (w, h) = (c.width as usize, c.height as usize);
+    let rays: Vec<Ray> = (0..w * h)
+        .map(|p| Ray {
+            origin: c.position,
+            dir: c.direction((p % w) as f32 + 0.5, (p / w) as f32 + 0.5),
+            t_min: 0.0,
+            t_max: f32::INFINITY,
+        })
+        .collect();
+    let mut hits = vec![None; rays.len()];
+    vis.intersect(&rays, &mut hits).unwrap();
+    rays.iter()
+        .zip(&hits)
+        .map(|(r, h)| h.map(|h| r.origin + h.t * r.dir))
+        .collect()
+}
+
+/// Our mean over the pixels `chosen` picks divided by the reference's, minus 1; and how many.
+fn band(
+    ours: &Image,
+    reference: &Image,
+    points: &[Option<Vec3>],
+    chosen: impl Fn(Vec3) -> bool,
+) -> (f64, usize) {
+    let (mut a, mut b, mut n) = (0.0f64, 0.0f64, 0usize);
+    for (p, q) in points.iter().enumerate() {
+        if q.is_some_and(&chosen) {
+            a += f64::from(ours.pixels[p].element_sum());
+            b += f64::from(reference.pixels[p].element_sum());
+            n += 1;
+        }
+    }
+    (a / b - 1.0, n)
+}
+
+fn meshless(scene: &Scene, vis: &dyn Visibility, gather_rays: u32) -> Image {
+    let solution =
+        meshlight::solve(scene, vis, &Options::default(), &mut |_| Control::Continue).unwrap();
+    let options = RenderOptions {
+        gather_rays,
+        ..RenderOptions::default()
+    };
+    meshlight::render(scene, &solution, vis, &options, &mut |_| Control::Continue)
+        .unwrap()
+        .0
+}
+
+fn traced(scene: &Scene, vis: &dyn Visibility, spp: u32) -> Image {
+    let options = PathOptions {
+        spp,
+        ..PathOptions::default()
+    };
+    path_trace(scene, vis, &options, &mut |_| Control::Continue)
+        .unwrap()
+        .image
+}
+
+#[test]
+fn a_box_on_a_floor_keeps_its_contact_shadow() {
+    let scene = box_on_floor();
+    let front = |q: Vec3| (q.z - BOX_LO.z).abs() < 1e-3 && (BOX_LO.x..BOX_HI.x).contains(&q.x);
+    let foot = move |q: Vec3| front(q) && q.y < BAND;
+    let floor = |q: Vec3| {
+        q.y < 1e-3
+            && (BOX_LO.z - BAND..BOX_LO.z).contains(&q.z)
+            && (BOX_LO.x..BOX_HI.x).contains(&q.x)
+    };
+    // The floor 0.3 to 0.6 m before the box: no crease there.
+    let control = |q: Vec3| {
+        q.y < 1e-3
+            && (BOX_LO.z - 0.6..BOX_LO.z - 0.3).contains(&q.z)
+            && (BOX_LO.x..BOX_HI.x).contains(&q.x)
+    };
+    for backend in backends() {
+        let vis = backend.build(&scene).unwrap();
+        let points = seen(&scene, vis.as_ref());
+        let reference = traced(&scene, vis.as_ref(), 512);
+        let ours = meshless(&scene, vis.as_ref(), RenderOptions::default().gather_rays);
+        let plain = meshless(&scene, vis.as_ref(), 0);
+        for (name, chosen) in [
+            ("the box's lowest 5 cm", &foot as &dyn Fn(Vec3) -> bool),
+            ("the floor within 5 cm of the box", &floor),
+            ("the floor 0.3-0.6 m before the box", &control),
+        ] {
+            let (e, n) = band(&ours, &reference, &points, chosen);
+            let (e0, _) = band(&plain, &reference, &points, chosen);
+            eprintln!(
+                "{backend}: {name}: {:+.2}% (interpolated alone {:+.2}%), {n} pixels",
+                100.0 * e,
+                100.0 * e0
+            );
+            assert!(n > 150, "{backend}: {name}: {n} pixels");
+            assert!(e.abs() < 0.05, "{backend}: {name}: {:+.2}%", 100.0 * e);
+        }
+        let (e0, _) = band(&plain, &reference, &points, foot);
+        assert!(
+            e0 > 0.05,
+            "{backend}: interpolation alone reads the foot {:+.2}%",
+            100.0 * e0
+        );
+    }
+}
+
+#[test]
+fn a_room_s_ceiling_wall_edge_is_not_too_bright() {
+    // The shipped room, looking up at its back wall's top edge.
+    let mut scene = Scene::load(shipped("room")).unwrap();
+    scene
+        .set_camera(camera(
+            Vec3::new(2.75, 5.0, 8.3),
+            Vec3::new(2.75, 5.5, 9.0),
+            96,
+        ))
+        .unwrap();
+    let (top, back) = (5.5f32, 9.0f32);
+    let ceiling = |q: Vec3| q.y > top - 1e-3 && (back - BAND..back).contains(&q.z);
+    let wall = |q: Vec3| q.z > back - 1e-3 && (top - BAND..top).contains(&q.y);
+    for backend in backends() {
+        let vis = backend.build(&scene).unwrap();
+        let points = seen(&scene, vis.as_ref());
+        let reference = traced(&scene, vis.as_ref(), 1024);
+        let ours = meshless(&scene, vis.as_ref(), RenderOptions::default().gather_rays);
+        let plain = meshless(&scene, vis.as_ref(), 0);
+        for (name, chosen) in [
+            (
+                "the ceiling within 5 cm of the wall",
+                &ceiling as &dyn Fn(Vec3) -> bool,
+            ),
+            ("the wall within 5 cm of the ceiling", &wall),
+        ] {
+            let (e, n) = band(&ours, &reference, &points, chosen);
+            let (e0, _) = band(&plain, &reference, &points, chosen);
+            eprintln!(
+                "{backend}: {name}: {:+.2}% (interpolated alone {:+.2}%), {n} pixels",
+                100.0 * e,
+                100.0 * e0
+            );
+            assert!(n > 150, "{backend}: {name}: {n} pixels");
+            assert!(e.abs() < 0.03, "{backend}: {name}: {:+.2}%", 100.0 * e);
+            assert!(
+                e0 > 0.03,
+                "{backend}: {name}: interpolated alone {:+.2}%",
+                100.0 * e0
+            );
+        }
+    }
+}
