@@ -38,8 +38,6 @@ pub(crate) struct Interpolator<'a> {
     /// Whether weights are those of a local-linear fit (see [`local_linear`]); plain kernel
     /// weights (all positive) where they enter the solve as transport.
     linear: bool,
-    /// Whether each sample must be in sight of the point (see [`Interpolator::blind`]).
-    sight: bool,
 }
 
 impl<'a> Interpolator<'a> {
@@ -55,7 +53,6 @@ impl<'a> Interpolator<'a> {
             lift: crate::visibility::lift(scene),
             support,
             linear: true,
-            sight: true,
         }
     }
 
@@ -71,12 +68,18 @@ impl<'a> Interpolator<'a> {
         &self.solution.samples
     }
 
-    /// The same, without asking whether each sample is in sight, in the index's order: for
-    /// the many points a final gather reads, each a small share of its answer, where the
+    /// The sample of the site's side nearest to it (among those covered as it is, if any),
+    /// seen from it or not: the cheapest reading of the light there, for the far hits of a
+    /// final gather, each a small share of its answer, where kernels and their visibility
     /// queries would cost more than the rest of the render.
-    pub(crate) fn blind(mut self) -> Self {
-        self.sight = false;
-        self
+    pub(crate) fn nearest(&self, site: &Site) -> Option<u32> {
+        let (s, index) = (&self.solution.samples, &self.solution.index);
+        let uv = self.solution.maps[surface_of(site.side) as usize].to_2d(site.point);
+        index
+            .nearest_where(s, site.side, uv, |k| {
+                self.sample_covered(k as usize) == site.covered
+            })
+            .or_else(|| index.nearest(s, site.side, uv))
     }
 
     /// Whether a side has samples to interpolate.
@@ -96,7 +99,7 @@ impl<'a> Interpolator<'a> {
     }
 
     /// The samples each site interpolates, with their kernel weights (not normalised), in
-    /// sample order (but see [`Interpolator::blind`]); or its nearest visible sample (weight 1); or none when it is sealed off
+    /// sample order; or its nearest visible sample (weight 1); or none when it is sealed off
     /// from them all. Returns the visibility queries.
     pub(crate) fn weights(&self, sites: &[Site], out: &mut Vec<Vec<(u32, f32)>>) -> Result<u64> {
         let s = &self.solution.samples;
@@ -112,13 +115,9 @@ impl<'a> Interpolator<'a> {
             self.solution
                 .index
                 .within(s, site.side, uv, reach, &mut near);
-            // In sample order, as documented; a gather's points skip it (the index's order is
-            // as deterministic, and they are many).
-            if self.sight {
-                near.sort_unstable_by_key(|&(k, _)| k);
-            }
+            near.sort_unstable_by_key(|&(k, _)| k);
             let start = candidates.len();
-            let test = self.sight && self.solution.obstruction.is_obstructed(site.side);
+            let test = self.solution.obstruction.is_obstructed(site.side);
             for &(k, d2) in &near {
                 let r = SUPPORT * s.radius[k as usize];
                 let q = d2 / (r * r);

@@ -496,8 +496,6 @@ struct Shader<'a> {
     scene: &'a Scene,
     vis: &'a dyn Visibility,
     interpolator: Interpolator<'a>,
-    /// The same for the points gathers read ([`Interpolator::blind`]).
-    blind: Interpolator<'a>,
     /// What the pixels hold.
     quantity: Quantity,
     /// What each sample shows (see [`Shader::new`]), computed once: hits ask for it many times.
@@ -510,6 +508,8 @@ struct Shader<'a> {
     outgoing: Vec<(glam::DVec3, glam::DVec3)>,
     /// Gather rays per pixel.
     gather_rays: u32,
+    /// Direct light traced at a gather's hits near its point (none: nothing gathers).
+    near_light: Option<DirectLight>,
     /// Direct light traced at the hits, when the pixels take theirs from there.
     light: Option<DirectLight>,
     /// The same with [`PENUMBRA_RAYS`] times the rays, for hits in a penumbra.
@@ -635,12 +635,18 @@ impl<'a> Shader<'a> {
             scene,
             vis,
             interpolator: Interpolator::new(scene, solution, vis),
-            blind: Interpolator::new(scene, solution, vis).blind(),
             quantity: options.quantity,
             values,
             full,
             outgoing,
             gather_rays: options.gather_rays,
+            near_light: gathers.then(|| {
+                DirectLight::with_specular(
+                    scene,
+                    gather::NEAR_LIGHT_SAMPLES,
+                    solution.specular_depth,
+                )
+            }),
             light,
             penumbra,
             paths: {
