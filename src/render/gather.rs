@@ -4,10 +4,12 @@
 //! region's average. At a camera hit with another surface within its samples' kernels, the
 //! inter-reflected irradiance is therefore gathered there: rays over the hemisphere, each
 //! reading the light its hit reflects from the samples there. Visibility at the hit itself is
-//! then exact, which is what the crease is made of. Hits of the gather near the crease gather
-//! in turn with fewer rays (their interpolated light is as wrong as the first hit's). The
-//! gather is blended with the interpolated value by how much of the hemisphere the near
-//! surfaces fill, so it fades out smoothly away from them and costs nothing on open surfaces.
+//! then exact, which is what the crease is made of. The gather's hits along the crease (within
+//! the reach) are as wrong as the first hit when interpolated: they are interpolated in full,
+//! their direct light traced, and they gather in turn with a few rays; its far hits read their
+//! nearest sample. The gather is blended with the interpolated value by how much of the
+//! hemisphere the near surfaces fill, so it fades out smoothly away from them and costs
+//! nothing on open surfaces.
 
 use glam::{DVec3, Vec3};
 
@@ -62,8 +64,9 @@ struct Spot {
 const LEVELS: u32 = 2;
 const NEXT_RAYS: u32 = 4;
 
-/// Spots gathered at once: bounds the memory of a batch of rays whatever the image's width.
-const SPOTS_AT_ONCE: usize = 256;
+/// First-level gather rays cast at once: bounds a batch's memory (its rays, hits, sites and
+/// the next level's) whatever the image's width and the rays per hit.
+const RAYS_AT_ONCE: usize = 1 << 15;
 
 impl Shader<'_> {
     /// For each hit that gets its direct light traced, with the reach it is interpolated over
@@ -82,10 +85,15 @@ impl Shader<'_> {
         }
         let rays = (self.gather_rays / share).max(MIN_SHARED_RAYS);
         let per_hit = (PROBES / share).max(MIN_SHARED_PROBES);
-        // Which hits have a surface within their reach.
-        let probes: Vec<Segment> = hits
+        // Which hits have a surface within their reach (one sealed off from its samples has
+        // none).
+        let reached: Vec<usize> = (0..hits.len())
+            .filter(|&i| hits[i].1 > 0.0 && hits[i].1.is_finite())
+            .collect();
+        let probes: Vec<Segment> = reached
             .iter()
-            .flat_map(|&(p, reach)| {
+            .flat_map(|&i| {
+                let (p, reach) = hits[i];
                 let from = p.point + self.lift * p.normal;
                 directions(p.normal, per_hit, seed(PROBE_SEED, u64::from(p.id))).map(move |d| {
                     Segment {
@@ -97,11 +105,10 @@ impl Shader<'_> {
             .collect();
         let mut blocked = vec![false; probes.len()];
         self.vis.occluded(&probes, &mut blocked)?;
-        let near: Vec<usize> = (0..hits.len())
-            .filter(|&i| {
-                let k = per_hit as usize;
-                blocked[i * k..(i + 1) * k].contains(&true)
-            })
+        let k = per_hit as usize;
+        let near: Vec<usize> = (0..reached.len())
+            .filter(|&r| blocked[r * k..(r + 1) * k].contains(&true))
+            .map(|r| reached[r])
             .collect();
         let spots: Vec<Spot> = near
             .iter()
@@ -113,7 +120,8 @@ impl Shader<'_> {
             })
             .collect();
         let mut queries = probes.len() as u64;
-        for (near, spots) in near.chunks(SPOTS_AT_ONCE).zip(spots.chunks(SPOTS_AT_ONCE)) {
+        let at_once = (RAYS_AT_ONCE / rays as usize).max(1);
+        for (near, spots) in near.chunks(at_once).zip(spots.chunks(at_once)) {
             let (gathered, q) = self.gather_at(spots, rays, LEVELS - 1)?;
             queries += q;
             for (&i, g) in near.iter().zip(gathered) {

@@ -276,7 +276,7 @@ pub fn render_distributed(
         let all = crate::distributed::for_share(
             ranks,
             &mut centre,
-            w * 4,
+            w,
             options.threads,
             trace,
             &mut |f| {
@@ -313,7 +313,7 @@ pub fn render_distributed(
         let refined_all = crate::distributed::for_share(
             ranks,
             &mut refined,
-            64,
+            16,
             options.threads,
             refine,
             &mut |f| {
@@ -453,14 +453,25 @@ impl Edges {
             }
         }
         let mut shaded = vec![(Vec3::ZERO, 0u32); rays.len()];
-        // A pixel's rays share its gather (the grid averages their answers); the largest
-        // grid of the batch sets the share.
-        let n = self.per_side[first..first + out.len()]
-            .iter()
-            .max()
-            .copied()
-            .unwrap_or(1) as u32;
-        let queries = shader.shade(&rays, self.first_ray[first] as u32, &mut shaded, n * n)?;
+        // A pixel's rays share its gather (the grid averages their answers): runs of pixels
+        // with grids of one size are shaded together, so what a pixel gets does not depend on
+        // the batch it falls in.
+        let sides = &self.per_side[first..first + out.len()];
+        let mut queries = 0;
+        let (mut pixel, mut ray) = (0, 0);
+        while pixel < sides.len() {
+            let n = sides[pixel];
+            let run = sides[pixel..].iter().take_while(|&&m| m == n).count();
+            let rays_in_run = run * n * n;
+            queries += shader.shade(
+                &rays[ray..ray + rays_in_run],
+                (self.first_ray[first] + ray) as u32,
+                &mut shaded[ray..ray + rays_in_run],
+                (n * n) as u32,
+            )?;
+            pixel += run;
+            ray += rays_in_run;
+        }
         let mut rest = &shaded[..];
         for (o, &n) in out.iter_mut().zip(&self.per_side[first..]) {
             let (group, tail) = rest.split_at(n * n);
