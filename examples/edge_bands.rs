@@ -41,16 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if (image.width, image.height) != (reference.width, reference.height) {
         return Err("the reference is not at the scene's image size".into());
     }
-    let c = scene.camera();
-    let (w, h) = (c.width as usize, c.height as usize);
-    let rays: Vec<Ray> = (0..w * h)
-        .map(|p| Ray {
-            origin: c.position,
-            dir: c.direction((p % w) as f32 + 0.5, (p / w) as f32 + 0.5),
-            t_min: 0.0,
-            t_max: f32::INFINITY,
-        })
-        .collect();
+    let rays: Vec<Ray> = scene.camera().pixel_centres().collect();
     let mut hits = vec![None; rays.len()];
     vis.intersect(&rays, &mut hits)?;
     let (lo, hi) = (scene.bounds().min, scene.bounds().max);

@@ -108,16 +108,7 @@ fn the_penumbra_follows_the_closed_form_pixel_by_pixel() {
             Control::Continue
         })
         .unwrap();
-        let c = scene.camera();
-        let (w, h) = (c.width as usize, c.height as usize);
-        let rays: Vec<Ray> = (0..w * h)
-            .map(|p| Ray {
-                origin: c.position,
-                dir: c.direction((p % w) as f32 + 0.5, (p / w) as f32 + 0.5),
-                t_min: 0.0,
-                t_max: f32::INFINITY,
-            })
-            .collect();
+        let rays: Vec<Ray> = scene.camera().pixel_centres().collect();
         let mut hits = vec![None; rays.len()];
         vis.intersect(&rays, &mut hits).unwrap();
         let floor: Vec<(usize, Vec3)> = (0..rays.len())

@@ -98,6 +98,18 @@ impl Camera {
         let sy = (h - 2.0 * y) / h * tan_half;
         (forward + sx * right + sy * up).normalize()
     }
+
+    /// One ray through each pixel's centre, row by row from the top-left: the points a
+    /// rendered image's pixels see, for measuring an image region by region.
+    pub fn pixel_centres(&self) -> impl Iterator<Item = crate::visibility::Ray> + '_ {
+        let w = self.width as usize;
+        (0..w * self.height as usize).map(move |p| crate::visibility::Ray {
+            origin: self.position,
+            dir: self.direction((p % w) as f32 + 0.5, (p / w) as f32 + 0.5),
+            t_min: 0.0,
+            t_max: f32::INFINITY,
+        })
+    }
 }
 
 #[cfg(test)]
