@@ -223,8 +223,8 @@ fn a_huge_camera_is_refused_before_its_image_is_allocated() {
 }
 
 #[test]
-fn a_huge_supersample_is_refused() {
-    isolated("a_huge_supersample_is_refused", || {
+fn a_huge_supersample_or_gather_is_refused() {
+    isolated("a_huge_supersample_or_gather_is_refused", || {
         let scene = room();
         let vis = Backend::Bvh.build(&scene).unwrap();
         let s = meshlight::solve(&scene, vis.as_ref(), &quick(), &mut go).unwrap();
@@ -234,6 +234,20 @@ fn a_huge_supersample_is_refused() {
         };
         let r = meshlight::render(&scene, &s, vis.as_ref(), &options, &mut go);
         refused("supersample 4096", r.map(|_| ()), &["supersample"]);
+        let options = RenderOptions {
+            gather_rays: u32::MAX,
+            ..RenderOptions::default()
+        };
+        let r = meshlight::render(&scene, &s, vis.as_ref(), &options, &mut go);
+        refused("gather rays u32::MAX", r.map(|_| ()), &["gather_rays"]);
+        // The most gather rays allowed, in a room whose every pixel is near a corner, end
+        // within the child's address space and watchdog.
+        let options = RenderOptions {
+            gather_rays: meshlight::render::MAX_GATHER_RAYS,
+            ..RenderOptions::default()
+        };
+        let (image, _) = meshlight::render(&scene, &s, vis.as_ref(), &options, &mut go).unwrap();
+        assert!(image.mean() > 0.0 && image.mean().is_finite());
     });
 }
 
