@@ -482,6 +482,12 @@ impl Edges {
     }
 }
 
+/// `v` per unit reflectance `rho`, channel by channel (0 where a channel reflects nothing).
+fn per_unit(v: glam::DVec3, rho: glam::DVec3) -> glam::DVec3 {
+    let ratio = |v: f64, rho: f64| if rho > 0.0 { v / rho } else { 0.0 };
+    glam::DVec3::new(ratio(v.x, rho.x), ratio(v.y, rho.y), ratio(v.z, rho.z))
+}
+
 /// The up to eight pixels around pixel p of a w × h image.
 fn neighbours(p: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
     let (x, y) = ((p % w) as isize, (p / w) as isize);
@@ -582,13 +588,7 @@ impl<'a> Shader<'a> {
                 let reflected = solution.radiosity[k] - rho * direct;
                 if scene.is_textured(crate::sampling::surface_of(s.side[k])) {
                     let e = crate::solver::emission_of(scene, s, k);
-                    let per_unit =
-                        |b: f64, e: f64, rho: f64| if rho > 0.0 { (b - e) / rho } else { 0.0 };
-                    glam::DVec3::new(
-                        per_unit(reflected.x, e.x, rho.x),
-                        per_unit(reflected.y, e.y, rho.y),
-                        per_unit(reflected.z, e.z, rho.z),
-                    ) / std::f64::consts::PI
+                    per_unit(reflected - e, rho) / std::f64::consts::PI
                 } else {
                     reflected / std::f64::consts::PI
                 }
@@ -617,15 +617,9 @@ impl<'a> Shader<'a> {
                     let reflected = solution.radiosity[k]
                         - crate::solver::emission_of(scene, s, k)
                         - rho * direct;
-                    let ratio = |b: f64, rho: f64| if rho > 0.0 { b / rho } else { 0.0 };
-                    let per_unit = glam::DVec3::new(
-                        ratio(reflected.x, rho.x),
-                        ratio(reflected.y, rho.y),
-                        ratio(reflected.z, rho.z),
-                    );
                     (
                         direct / std::f64::consts::PI,
-                        per_unit / std::f64::consts::PI,
+                        per_unit(reflected, rho) / std::f64::consts::PI,
                     )
                 })
                 .collect()
