@@ -64,6 +64,18 @@ impl Shooter {
     }
 }
 
+/// The second moments x xᵀ of a point, as xx, xy, xz, yy, yz, zz.
+fn outer(x: DVec3) -> [f64; 6] {
+    [
+        x.x * x.x,
+        x.x * x.y,
+        x.x * x.z,
+        x.y * x.y,
+        x.y * x.z,
+        x.z * x.z,
+    ]
+}
+
 /// The offsets L sₖ for the spread `q` (a symmetric 3×3 as xx, xy, xz, yy, yz, zz), with L its
 /// Cholesky factor; pivots a spread does not have (flat or thin nodes) are left out, and a
 /// spread that is not positive (mixed signs of unshot power) gives none.
@@ -109,15 +121,7 @@ impl Sums {
         Sums {
             moments: [n * b.x, n * b.y, n * b.z],
             weighted: x * w,
-            second: [
-                x.x * x.x,
-                x.x * x.y,
-                x.x * x.z,
-                x.y * x.y,
-                x.y * x.z,
-                x.z * x.z,
-            ]
-            .map(|v| v * w),
+            second: outer(x).map(|v| v * w),
             weight: w,
             magnitude: w.abs(),
         }
@@ -368,16 +372,7 @@ mod tests {
         let c: DVec3 = members.iter().map(|m| m.0 * m.1).sum::<DVec3>() / weight;
         let mut q = [0.0; 6];
         for (p, w) in &members {
-            let d = *p - c;
-            let terms = [
-                d.x * d.x,
-                d.x * d.y,
-                d.x * d.z,
-                d.y * d.y,
-                d.y * d.z,
-                d.z * d.z,
-            ];
-            for (q, t) in q.iter_mut().zip(terms) {
+            for (q, t) in q.iter_mut().zip(outer(*p - c)) {
                 *q += w * t / weight;
             }
         }
@@ -432,15 +427,7 @@ mod tests {
         assert!(mean.length() < 1e-6);
         let mut got = [0.0; 6];
         for p in points.map(|p| p.as_dvec3()) {
-            let terms = [
-                p.x * p.x,
-                p.x * p.y,
-                p.x * p.z,
-                p.y * p.y,
-                p.y * p.z,
-                p.z * p.z,
-            ];
-            for (g, t) in got.iter_mut().zip(terms) {
+            for (g, t) in got.iter_mut().zip(outer(p)) {
                 *g += t / 4.0;
             }
         }
