@@ -206,6 +206,21 @@ fn one_or_two_workers_and_any_pipeline_capacity_give_the_same_answer() {
 
 /// `cornell` with its whites (Kd 0.72) at Kd 0.95: light is reflected about twenty times, so a
 /// small loss per transfer compounds.
+/// `scene` solved on the same samples (no adaptive rounds) to 1e-6 by the flat solver and by
+/// the hierarchy at its default threshold.
+fn flat_and_tree(scene: &Scene, backend: Backend) -> (meshlight::Solution, meshlight::Solution) {
+    let at = |threshold| {
+        let options = Options {
+            tolerance: 1e-6,
+            rounds: 0,
+            cluster_threshold: threshold,
+            ..Options::default()
+        };
+        solve(scene, backend, options)
+    };
+    (at(0.0), at(Options::default().cluster_threshold))
+}
+
 fn cornell_at_0_95() -> Scene {
     let mut scene = Scene::load(shipped("cornell")).unwrap();
     let white = scene
@@ -280,20 +295,11 @@ fn at_albedo_0_95_the_hierarchy_delivers_what_its_shooters_send() {
     // before the sweeps were balanced).
     let scene = cornell_at_0_95();
     for backend in backends() {
-        let left = |threshold| {
-            let s = solve(
-                &scene,
-                backend,
-                Options {
-                    tolerance: 1e-6,
-                    rounds: 0,
-                    cluster_threshold: threshold,
-                    ..Options::default()
-                },
-            );
+        let left = |s: meshlight::Solution| {
             s.ledger().escaped.element_sum() / s.ledger().emitted.element_sum()
         };
-        let (flat, tree) = (left(0.0), left(Options::default().cluster_threshold));
+        let (flat, tree) = flat_and_tree(&scene, backend);
+        let (flat, tree) = (left(flat), left(tree));
         assert!(
             (tree - flat).abs() < 0.002,
             "{backend}: {:.3}% of the emitted power leaves the hierarchy's surfaces, {:.3}% the flat solver's",
@@ -312,26 +318,14 @@ fn at_albedo_0_95_the_hierarchy_reflects_as_much_light_as_the_flat_solver() {
     // (0.21% with seed 5); shooting from four points with the node's spread, 0.005% less.
     let scene = cornell_at_0_95();
     for backend in backends() {
-        let reflected = |threshold| {
-            let s = solve(
-                &scene,
-                backend,
-                Options {
-                    tolerance: 1e-6,
-                    rounds: 0,
-                    cluster_threshold: threshold,
-                    ..Options::default()
-                },
-            );
+        let reflected = |s: meshlight::Solution| {
             let samples = s.samples();
             (0..samples.len())
                 .map(|k| s.radiosity()[k].element_sum() * samples.area()[k])
                 .sum::<f64>()
         };
-        let (flat, tree) = (
-            reflected(0.0),
-            reflected(Options::default().cluster_threshold),
-        );
+        let (flat, tree) = flat_and_tree(&scene, backend);
+        let (flat, tree) = (reflected(flat), reflected(tree));
         let off = tree / flat - 1.0;
         eprintln!(
             "{backend}: the hierarchy reflects {:+.4}% of the flat solver's light",

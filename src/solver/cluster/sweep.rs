@@ -56,7 +56,7 @@ const CORNERS: [DVec3; 4] = [
 impl Shooter {
     /// The points it shoots from, each with its share of the moments.
     fn points(&self) -> ([DVec3; 4], usize, f64) {
-        if self.spread[0] == Vec3::ZERO && self.spread[1] == Vec3::ZERO {
+        if self.spread == [Vec3::ZERO; 4] {
             ([self.centre; 4], 1, 1.0)
         } else {
             (self.spread.map(|o| self.centre + o.as_dvec3()), 4, 0.25)
@@ -161,16 +161,9 @@ pub(crate) fn shooters(tree: &Tree, samples: &Samples, unshot: &[DVec3]) -> Vec<
         .map(|(s, node)| {
             if s.magnitude > 0.0 && s.weight.abs() >= 0.5 * s.magnitude {
                 let c = s.weighted / s.weight;
-                let m = s.second.map(|v| v / s.weight);
                 // The spread about c: Σ w x xᵀ / Σ w − c cᵀ.
-                let q = [
-                    m[0] - c.x * c.x,
-                    m[1] - c.x * c.y,
-                    m[2] - c.x * c.z,
-                    m[3] - c.y * c.y,
-                    m[4] - c.y * c.z,
-                    m[5] - c.z * c.z,
-                ];
+                let cc = outer(c);
+                let q = std::array::from_fn(|i| s.second[i] / s.weight - cc[i]);
                 Shooter {
                     moments: s.moments,
                     centre: c,
