@@ -6,7 +6,9 @@
 //!   the polygon clipped to the receiver's upper half-space), times the visible fraction of
 //!   stratified shadow rays weighted by their unshadowed contributions: the ratio estimator of
 //!   Heitz, Hill and McGuire, "Combining Analytic Direct Illumination and Stochastic Shadows"
-//!   (2018). Fully lit and fully shadowed points are exact; only penumbrae carry noise.
+//!   (2018). Fully lit and fully shadowed points are exact; only penumbrae carry noise. The
+//!   rays are drawn over the solid angle an emitter subtends ([`spherical`]), which keeps the
+//!   ratio's bias small beside large emitters.
 
 use glam::{DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
@@ -20,6 +22,18 @@ use crate::specular::images::{self, Chain};
 use crate::specular::shadow::{self, LightPath};
 use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
+
+mod spherical;
+
+/// Emitters subtending less than this (sr) from a receiver have their shadow rays drawn
+/// uniformly over their area: their rays weigh nearly alike, and from so far rounding would
+/// blur the solid-angle draw.
+const MIN_SOLID_ANGLE: f64 = 1e-4;
+
+/// An emitter is drawn over solid angle from receivers nearer than its radius / NEAR to its
+/// centre, over its area from farther (where its rays' weights vary by less than about
+/// ±2·NEAR, and the ratio's bias with them).
+const NEAR: f32 = 0.3;
 
 /// The most shadow rays per area light and receiver a caller may ask for.
 pub const MAX_LIGHT_SAMPLES: u32 = 1 << 16;
@@ -40,6 +54,20 @@ struct Emitter {
     ke: DVec3,
     /// Whether its front reflects light too (then it has samples of its own).
     reflects: bool,
+    /// A sphere around it (centre, radius): how near a receiver stands.
+    bounds: (Vec3, f32),
+}
+
+/// The sphere around some triangles: their vertices' mean and the farthest vertex from it.
+fn bounds(triangles: &[[Vec3; 3]]) -> (Vec3, f32) {
+    let n = (3 * triangles.len()).max(1) as f32;
+    let centre = triangles.iter().flatten().fold(Vec3::ZERO, |a, &v| a + v) / n;
+    let radius = triangles
+        .iter()
+        .flatten()
+        .map(|v| v.distance(centre))
+        .fold(0.0f32, f32::max);
+    (centre, radius)
 }
 
 /// Direct light from a scene's lights.
@@ -95,6 +123,7 @@ impl DirectLight {
                     })
                     .collect();
                 Emitter {
+                    bounds: bounds(&tris),
                     triangles: tris,
                     cumulative,
                     normal: surface.normal,
@@ -139,6 +168,7 @@ impl DirectLight {
                                 .collect();
                             Emitter {
                                 offset: normal.dot(triangles[0][0]),
+                                bounds: bounds(&triangles),
                                 normal,
                                 triangles,
                                 cumulative: e.cumulative.clone(),
@@ -352,6 +382,7 @@ impl DirectLight {
         let mut paths = Vec::new();
         // Per shadow ray: (slot, weight).
         let mut rays: Vec<(usize, f64)> = Vec::new();
+        let mut draw = spherical::Draw::default();
         for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
             let from = x + self.lift * n;
             let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 2));
@@ -377,7 +408,7 @@ impl DirectLight {
                         emitter,
                         (x, n, from),
                         (slot, chain, w == 0),
-                        &mut rng,
+                        (&mut rng, &mut draw),
                         (&mut analytic, &mut factor, &mut weights),
                         (&mut paths, &mut rays),
                         unoccluded.get_mut(r).expect("one per receiver"),
@@ -413,7 +444,7 @@ impl DirectLight {
         emitter: &Emitter,
         (x, n, from): (Vec3, Vec3, Vec3),
         (slot, chain, straight): (usize, &'c [u32], bool),
-        rng: &mut Pcg64Mcg,
+        (rng, draw): (&mut Pcg64Mcg, &mut spherical::Draw),
         (analytic, factor, weights): (&mut [DVec3], &mut [f64], &mut [(f64, DVec3)]),
         (paths, rays): (&mut Vec<LightPath<'c>>, &mut Vec<(usize, f64)>),
         unoccluded: &mut f64,
@@ -435,28 +466,41 @@ impl DirectLight {
             factor[slot] = irradiance / std::f64::consts::PI;
         }
         *unoccluded += (emitter.ke * irradiance).element_sum();
-        let total = *emitter.cumulative.last().unwrap_or(&0.0);
+        // Near emitters are drawn uniformly in solid angle, far ones (or ones rounding defeats)
+        // uniformly in area: see `spherical`.
+        let (centre, radius) = emitter.bounds;
+        let solid = radius > NEAR * x.distance(centre)
+            && draw.prepare(&emitter.triangles, x, MIN_SOLID_ANGLE);
+        let cumulative = if solid {
+            draw.cumulative()
+        } else {
+            emitter.cumulative.as_slice()
+        };
+        let total = *cumulative.last().unwrap_or(&0.0);
         let count = self.light_samples;
         let shift = (rng.random::<f64>(), rng.random::<f64>());
         for s in 0..count {
             let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
             let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
-            // The first coordinate runs along the emitter's cumulative area: it picks the
-            // triangle, and what is left of it places the point inside.
+            // The first coordinate runs along the emitter's cumulative solid angle (or area):
+            // it picks the triangle, and what is left of it places the point inside.
             let u = u1 * total;
-            let t = emitter
-                .cumulative
+            let t = cumulative
                 .partition_point(|&c| c <= u)
                 .min(emitter.triangles.len() - 1);
-            let start = if t == 0 {
-                0.0
+            let start = if t == 0 { 0.0 } else { cumulative[t - 1] };
+            let within = ((u - start) / (cumulative[t] - start)).clamp(0.0, 1.0);
+            let y = if solid {
+                let y = draw
+                    .sample(t, within, u2)
+                    .and_then(|w| spherical::on_plane(emitter.normal, emitter.offset, x, w));
+                let Some(y) = y else { continue };
+                y
             } else {
-                emitter.cumulative[t - 1]
+                let [a, b, c] = emitter.triangles[t];
+                let (r1, r2) = (within.sqrt() as f32, u2 as f32);
+                a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
             };
-            let within = ((u - start) / (emitter.cumulative[t] - start)).clamp(0.0, 1.0);
-            let [a, b, c] = emitter.triangles[t];
-            let (r1, r2) = (within.sqrt() as f32, u2 as f32);
-            let y = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
             let d = y - x;
             let dist2 = d.length_squared();
             let cos_x = n.dot(d);
@@ -464,7 +508,13 @@ impl DirectLight {
             if cos_x <= 0.0 || cos_y <= 0.0 || dist2 <= 0.0 {
                 continue;
             }
-            let weight = f64::from(cos_x * cos_y / (dist2 * dist2));
+            // The integrand over the density the ray was drawn with, up to a factor common to
+            // all of this emitter's rays: cos_x over solid angle, cos_x·cos_y/r² over area.
+            let weight = if solid {
+                f64::from(cos_x / dist2.sqrt())
+            } else {
+                f64::from(cos_x * cos_y / (dist2 * dist2))
+            };
             weights[slot].0 += weight;
             let to = y + self.lift * emitter.normal;
             if let (Some(&k), Some((spec, _))) = (chain.first(), &self.specular) {
