@@ -30,11 +30,6 @@ mod spherical;
 /// blur the solid-angle draw.
 const MIN_SOLID_ANGLE: f64 = 1e-4;
 
-/// An emitter is drawn over solid angle from receivers nearer than its radius / NEAR to its
-/// centre, over its area from farther (where its rays' weights vary by less than about
-/// ±2·NEAR, and the ratio's bias with them).
-const NEAR: f32 = 0.3;
-
 /// The most shadow rays per area light and receiver a caller may ask for.
 pub const MAX_LIGHT_SAMPLES: u32 = 1 << 16;
 
@@ -450,7 +445,8 @@ impl DirectLight {
         unoccluded: &mut f64,
     ) {
         // Emitters light only what lies in front of them.
-        if emitter.normal.dot(x) - emitter.offset <= 0.0 {
+        let height = emitter.normal.dot(x) - emitter.offset;
+        if height <= 0.0 {
             return;
         }
         let irradiance: f64 = emitter
@@ -469,7 +465,7 @@ impl DirectLight {
         // Near emitters are drawn uniformly in solid angle, far ones (or ones rounding defeats)
         // uniformly in area: see `spherical`.
         let (centre, radius) = emitter.bounds;
-        let solid = radius > NEAR * x.distance(centre)
+        let solid = spherical::worth_drawing(height, radius, x.distance(centre))
             && draw.prepare(&emitter.triangles, x, MIN_SOLID_ANGLE);
         let cumulative = if solid {
             draw.cumulative()
@@ -491,11 +487,11 @@ impl DirectLight {
             let start = if t == 0 { 0.0 } else { cumulative[t - 1] };
             let within = ((u - start) / (cumulative[t] - start)).clamp(0.0, 1.0);
             let y = if solid {
-                let y = draw
-                    .sample(t, within, u2)
-                    .and_then(|w| spherical::on_plane(emitter.normal, emitter.offset, x, w));
-                let Some(y) = y else { continue };
-                y
+                let w = draw.sample(t, within, u2);
+                match w.and_then(|w| spherical::on_plane(emitter.normal, emitter.offset, x, w)) {
+                    Some(y) => y,
+                    None => continue,
+                }
             } else {
                 let [a, b, c] = emitter.triangles[t];
                 let (r1, r2) = (within.sqrt() as f32, u2 as f32);
