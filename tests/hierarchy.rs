@@ -209,11 +209,21 @@ fn one_or_two_workers_and_any_pipeline_capacity_give_the_same_answer() {
 /// `scene` solved on the same samples (no adaptive rounds) to 1e-6 by the flat solver and by
 /// the hierarchy at its default threshold.
 fn flat_and_tree(scene: &Scene, backend: Backend) -> (meshlight::Solution, meshlight::Solution) {
+    flat_and_tree_seeded(scene, backend, Options::default().seed)
+}
+
+/// [`flat_and_tree`] with another seed (other samples, other probes).
+fn flat_and_tree_seeded(
+    scene: &Scene,
+    backend: Backend,
+    seed: u64,
+) -> (meshlight::Solution, meshlight::Solution) {
     let at = |threshold| {
         let options = Options {
             tolerance: 1e-6,
             rounds: 0,
             cluster_threshold: threshold,
+            seed,
             ..Options::default()
         };
         solve(scene, backend, options)
@@ -312,10 +322,15 @@ fn at_albedo_0_95_the_hierarchy_delivers_what_its_shooters_send() {
 #[test]
 fn at_albedo_0_95_the_hierarchy_reflects_as_much_light_as_the_flat_solver() {
     // The same samples (no adaptive rounds), shot to convergence: the light all surfaces
-    // reflect, Σ B S, by the hierarchy and by the flat solver. A cluster link from its centre
-    // alone errs at second order in the shooter's extent, concave head-on and convex edge-on,
-    // and the receivers' row scales cannot take that out: the hierarchy reflected 0.10% less
-    // (0.21% with seed 5); shooting from four points with the node's spread, 0.005% less.
+    // reflect, Σ B S, by the hierarchy and by the flat solver, over five seeds. A cluster link
+    // from its centre alone errs at second order in the shooter's extent, concave head-on and
+    // convex edge-on, and the receivers' row scales cannot take that out: the hierarchy
+    // reflected 0.10% less (0.21% with seed 5); shooting from four points with the node's
+    // spread, 0.005% less at seed 1. The light hangs 1 cm under the ceiling, and a cluster
+    // link's eight probes could all land on ceiling samples in its gap, or all beside it:
+    // seeds 1-5 then gave -0.008, +0.083, +0.077, +0.026, -0.117%; refining the nodes the
+    // fixture hovers over (and those holding samples beside it), -0.023, +0.041, +0.037,
+    // +0.021, +0.000%.
     let scene = cornell_at_0_95();
     for backend in backends() {
         let reflected = |s: meshlight::Solution| {
@@ -324,14 +339,20 @@ fn at_albedo_0_95_the_hierarchy_reflects_as_much_light_as_the_flat_solver() {
                 .map(|k| s.radiosity()[k].element_sum() * samples.area()[k])
                 .sum::<f64>()
         };
-        let (flat, tree) = flat_and_tree(&scene, backend);
-        let (flat, tree) = (reflected(flat), reflected(tree));
-        let off = tree / flat - 1.0;
-        eprintln!(
-            "{backend}: the hierarchy reflects {:+.4}% of the flat solver's light",
-            100.0 * off
-        );
-        assert!(off.abs() < 5e-4, "{backend}: {:+.4}%", 100.0 * off);
+        for seed in 1..=5 {
+            let (flat, tree) = flat_and_tree_seeded(&scene, backend, seed);
+            let (flat, tree) = (reflected(flat), reflected(tree));
+            let off = tree / flat - 1.0;
+            eprintln!(
+                "{backend}, seed {seed}: the hierarchy reflects {:+.4}% of the flat solver's light",
+                100.0 * off
+            );
+            assert!(
+                off.abs() < 6e-4,
+                "{backend}, seed {seed}: {:+.4}%",
+                100.0 * off
+            );
+        }
     }
 }
 

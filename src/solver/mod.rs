@@ -741,4 +741,56 @@ mod tests {
         broken.order.swap(0, n - 1);
         assert!(broken.validate(&s.samples).is_err());
     }
+
+    #[test]
+    fn samples_beside_and_under_a_hanging_light_are_hovered_and_no_others() {
+        // cornell's light is the square [1.5, 2.5]² 1 cm under the ceiling (y = 3). A sample is
+        // asked about the disc of its radius D, boxed: a ceiling sample is hovered exactly when
+        // its box [x ± D] × [z ± D] meets the square; nothing else in the room hovers (walls
+        // meet the sides they stand on, the boxes stand on the floor).
+        let scene = Scene::load(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell/scene.toml"),
+        )
+        .unwrap();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            rounds: 0,
+            ..Options::default()
+        };
+        let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
+        let grid = TriangleGrid::new(&scene);
+        let cx = Context {
+            scene: &scene,
+            grid: &grid,
+            samples: &s.samples,
+            obstruction: &s.obstruction,
+            lift: crate::visibility::lift(&scene),
+        };
+        let n = s.samples.len();
+        let tree = cluster::tree::Tree::build(&s.samples, &vec![0.5; n], &vec![1.0; n], &cx);
+        let (mut hovered, mut checked) = (0, 0);
+        for k in 0..n {
+            let (p, d) = (s.samples.position[k], s.samples.radius[k]);
+            let gap = |c: f32| (c - 2.0).abs() - 0.5 - d;
+            let on_ceiling = (p.y - 3.0).abs() < 1e-4;
+            // Boxes that just touch the square are left out: a rounding either way is right.
+            if on_ceiling && gap(p.x).abs().min(gap(p.z).abs()) < 1e-4 {
+                continue;
+            }
+            let expected = on_ceiling && gap(p.x) <= 0.0 && gap(p.z) <= 0.0;
+            assert_eq!(tree.leaf[k].hovered, expected, "sample {k} at {p}, D {d}");
+            hovered += usize::from(expected);
+            checked += 1;
+        }
+        assert!(
+            hovered > 20 && checked + 4 > n,
+            "{hovered} hovered, {checked} of {n} checked"
+        );
+        // And a node holds a hovered sample exactly when one of its members is hovered.
+        for node in &tree.nodes {
+            let members = &tree.order[node.first as usize..(node.first + node.count) as usize];
+            let any = members.iter().any(|&k| tree.leaf[k as usize].hovered);
+            assert_eq!(node.holds_hovered, any);
+        }
+    }
 }

@@ -12,7 +12,9 @@
 //! tree splits a side's incoherent node along the plane of the triangle standing among its
 //! members (as a BSP would), so that an occluder costs a few incoherent nodes, not every node
 //! its outline crosses.
-//! Occluders that merely hover between a node and a shooter are what the link's rays are for.
+//! Occluders that merely hover between a node and a shooter are what the link's rays are for;
+//! one hovering close in front of a node (`sheltered`, `hovered_sample`) makes its members see
+//! differently, so the links refine such nodes rather than trust a few rays.
 
 use std::ops::Range;
 
@@ -209,12 +211,38 @@ pub(crate) fn sheltered(
         poly.extend_from_slice(&tri.vertices);
         clip_half_space(&mut poly, &mut scratch, normal, base + cx.lift);
         clip_half_space(&mut poly, &mut scratch, -normal, -(base + depth));
-        for axis in 0..3 {
-            let mut n = Vec3::ZERO;
-            n[axis] = 1.0;
-            clip_half_space(&mut poly, &mut scratch, n, blo[axis]);
-            clip_half_space(&mut poly, &mut scratch, -n, -bhi[axis]);
+        clip_box(&mut poly, &mut scratch, blo, bhi);
+        !poly.is_empty()
+    })
+}
+
+/// Whether something hovers within `depth` in front of sample `k`, over the disc of its
+/// influence radius: a light fixture just under a ceiling, seen from a sample beside it as well
+/// as from one under it. Geometry that reaches down to the side's plane (a wall meeting it, a
+/// box standing on it) does not hover: the coherence tests see to it.
+pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
+    let (p, n) = (cx.samples.position[k], cx.samples.normal[k]);
+    let surface = crate::sampling::surface_of(cx.samples.side[k]);
+    let half = cx.samples.radius[k] * (Vec3::ONE - n * n).max(Vec3::ZERO).sqrt();
+    let (lo, hi) = (p - half, p + half);
+    let (blo, bhi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
+    let base = n.dot(p);
+    let mut poly: Vec<Vec3> = Vec::with_capacity(9);
+    let mut scratch: Vec<Vec3> = Vec::with_capacity(9);
+    cx.grid.any(blo, bhi, |t| {
+        let tri = &cx.scene.triangles[t as usize];
+        let lowest = tri
+            .vertices
+            .iter()
+            .map(|v| n.dot(*v) - base)
+            .fold(f32::INFINITY, f32::min);
+        if tri.surface == surface || lowest <= 2.0 * cx.lift {
+            return false;
         }
+        poly.clear();
+        poly.extend_from_slice(&tri.vertices);
+        clip_half_space(&mut poly, &mut scratch, -n, -(base + depth));
+        clip_box(&mut poly, &mut scratch, blo, bhi);
         !poly.is_empty()
     })
 }
@@ -237,6 +265,16 @@ fn meets_box(t: &[Vec3; 3], lo: Vec3, hi: Vec3) -> bool {
         }
     }
     true
+}
+
+/// Clips a convex polygon to an axis-aligned box.
+fn clip_box(poly: &mut Vec<Vec3>, scratch: &mut Vec<Vec3>, lo: Vec3, hi: Vec3) {
+    for axis in 0..3 {
+        let mut n = Vec3::ZERO;
+        n[axis] = 1.0;
+        clip_half_space(poly, scratch, n, lo[axis]);
+        clip_half_space(poly, scratch, -n, -hi[axis]);
+    }
 }
 
 /// Clips a convex polygon to the half-space n·x ≥ c (closed, so a polygon touching the plane

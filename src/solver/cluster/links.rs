@@ -15,7 +15,10 @@
 //!   allows (the least taken as 0 where some members face away). Its visibility comes from
 //!   probes: member pairs, every pair when there are few, else stratified; a ray for each
 //!   pair that faces. All visible (and each node wholly in front of the other): linked. None:
-//!   dropped. Some: refined; where every pair was probed, each visible pair becomes a leaf
+//!   dropped. Unless some of the pairs were left unprobed and something hovers close in front
+//!   of either node (a light fixture just under a ceiling: members in its gap and members
+//!   beside it see the room differently, and all probes may land on one kind): then refined.
+//!   Some: refined; where every pair was probed, each visible pair becomes a leaf
 //!   link. Visibility never makes a link coarser. A partly visible link is averaged only where
 //!   everything it could carry is negligible, and never with `exact_visibility`: refining every
 //!   partial link down to samples follows each doorway's silhouette sample by sample, so its
@@ -267,11 +270,14 @@ impl Linker<'_> {
                 0.0
             }
         };
-        if (exhaustive && rays == 0) || (rays > 0 && visible == 0) {
+        // A few probes cannot vouch for a node something hovers close in front of: its members
+        // in the gap and those beside it see differently, and all probes may land on one kind.
+        let sure = exhaustive || !(self.hovered(p.a) || self.hovered(p.b));
+        if (exhaustive && rays == 0) || (rays > 0 && visible == 0 && sure) {
             // Nothing faces, or every facing pair is blocked.
-        } else if all && one_sided {
+        } else if all && one_sided && sure {
             self.cluster_links(p, p.dirs, [1.0, 1.0], found, same_group);
-        } else if all && conditioned {
+        } else if all && conditioned && sure {
             // Wholly visible, but some members face away.
             self.cluster_links(p, p.dirs, [factor(0), factor(1)], found, same_group);
         } else if exhaustive {
@@ -282,12 +288,15 @@ impl Linker<'_> {
         } else if negligible && rays > 0 {
             // Faint and partly visible: a receiver takes the share of the shooter its probes
             // see, unless it is a cluster something hovers close in front of (a gap its
-            // members may hide in, which would trap the light): that one is refined.
+            // members may hide in, which would trap the light) or one holding a sample in or
+            // beside such a gap (the fixture shades it from much of the room, and the share
+            // would light it as its neighbours): that one is refined.
             let mut to_leaf = 0;
             let mut refine = 0;
             for (dir, receiver) in [(INTO_B, p.b), (INTO_A, p.a)] {
                 if p.dirs & dir != 0 {
-                    if receiver.is_leaf() || !self.tree.nodes[receiver.index()].sheltered {
+                    let node = (!receiver.is_leaf()).then(|| &self.tree.nodes[receiver.index()]);
+                    if node.is_none_or(|n| !(n.sheltered || n.holds_hovered)) {
                         to_leaf |= dir;
                     } else {
                         refine |= dir;
@@ -306,6 +315,18 @@ impl Linker<'_> {
             }
         } else {
             self.split(pair_of(p), stack);
+        }
+    }
+
+    /// Whether something hovers close in front of `node`: a sample (see `LeafData::hovered`), or
+    /// a sheltered node on one side (nodes over several sides count as sheltered, but their
+    /// probes span the sides).
+    fn hovered(&self, node: Ref) -> bool {
+        if node.is_leaf() {
+            self.tree.leaf[node.index()].hovered
+        } else {
+            let n = &self.tree.nodes[node.index()];
+            n.sheltered && n.side != MULTI
         }
     }
 

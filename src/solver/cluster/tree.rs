@@ -10,7 +10,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::coherence::{sheltered, splitter, Context};
+use super::coherence::{hovered_sample, sheltered, splitter, Context};
 use crate::sampling::{Samples, Side};
 
 /// A reference to a tree node or to a single sample (a leaf).
@@ -90,6 +90,8 @@ pub(crate) struct Node {
     pub coherent: bool,
     /// Whether something hovers close in front of it (see `coherence::sheltered`).
     pub sheltered: bool,
+    /// Whether it holds a sample something hovers close in front of (see [`LeafData::hovered`]).
+    pub holds_hovered: bool,
 }
 
 /// Per-sample data the tree and the links use.
@@ -101,6 +103,9 @@ pub(crate) struct LeafData {
     pub rho: f32,
     /// p S (see [`Node::power`]).
     pub power: f64,
+    /// Whether something hovers close in front of the sample, within its radius D (see
+    /// `coherence::hovered_sample`; looked for only on sides whose top node is sheltered).
+    pub hovered: bool,
 }
 
 /// The tree.
@@ -145,6 +150,7 @@ impl Tree {
                 radius: region_radius(samples, k),
                 rho: rho[k],
                 power: weight[k] * samples.area[k],
+                hovered: false,
             })
             .collect();
         let mut tree = Tree {
@@ -178,29 +184,53 @@ impl Tree {
             tree.place[k as usize] = place as u32;
         }
         if !tree.nodes.is_empty() {
-            tree.mark_sheltered(cx, 0, true);
+            tree.mark_sheltered(cx, 0, true, true, true);
+            tree.mark_holds_hovered();
         }
         tree
     }
 
     /// Marks node `i`'s subtree: a node is sheltered when its parent is and something hovers
-    /// within a quarter of its radius in front of it.
-    fn mark_sheltered(&mut self, cx: &Context, i: usize, parent: bool) {
+    /// within a quarter of its radius in front of it. On a side whose top node is sheltered
+    /// (and under nodes over several sides) each sample is asked too, within its own radius
+    /// (`coherence::hovered_sample`). `top`: whether the parent spans several sides; `hover`:
+    /// whether the parent's samples are asked.
+    fn mark_sheltered(&mut self, cx: &Context, i: usize, parent: bool, top: bool, hover: bool) {
         let node = &self.nodes[i];
+        let multi = node.side == MULTI;
         let here = parent
             && sheltered(
                 cx,
-                (node.side != MULTI).then_some(node.side),
+                (!multi).then_some(node.side),
                 node.axis,
                 node.lo,
                 node.hi,
                 0.25 * node.radius,
             );
         self.nodes[i].sheltered = here;
+        let hover = multi || if top { here } else { hover };
         for c in self.nodes[i].children {
             if !c.is_leaf() {
-                self.mark_sheltered(cx, c.index(), here);
+                self.mark_sheltered(cx, c.index(), here, multi, hover);
+            } else if hover {
+                let k = c.index();
+                self.leaf[k].hovered = hovered_sample(cx, k, cx.samples.radius[k]);
             }
+        }
+    }
+
+    /// Marks the nodes that hold a hovered sample, children before parents (the nodes are in
+    /// pre-order).
+    fn mark_holds_hovered(&mut self) {
+        for i in (0..self.nodes.len()).rev() {
+            let holds = self.nodes[i].children.iter().any(|&c| {
+                if c.is_leaf() {
+                    self.leaf[c.index()].hovered
+                } else {
+                    self.nodes[c.index()].holds_hovered
+                }
+            });
+            self.nodes[i].holds_hovered = holds;
         }
     }
 
@@ -415,6 +445,7 @@ impl Tree {
             side: MULTI,
             coherent: false,
             sheltered: true,
+            holds_hovered: false,
         });
         index
     }
@@ -466,6 +497,7 @@ impl Tree {
             side: if a.side == b.side { a.side } else { MULTI },
             coherent: false,
             sheltered: true,
+            holds_hovered: false,
         };
     }
 
