@@ -85,6 +85,12 @@ const EXHAUSTIVE: usize = 16;
 /// links never cross a wall (nodes never straddle an occluder: `coherence`), so this only
 /// blurs a faint penumbra.
 const NEGLIGIBLE: f64 = 0.25;
+/// Sheltered nodes of at most this many members are refined when their probes agree but did
+/// not see every pair: a fixture's outline crossing such a node leaves a few members of each
+/// kind, which eight probes can all miss. Larger ones keep their probes' verdict: on `cornell`
+/// the limit changes nothing down to 16 (seeds 1-10), while refining every sheltered node
+/// took 5.6 times the visibility queries at a million samples (docs/accuracy.md).
+const HOVERED_MEMBERS: usize = 16;
 /// The least cosine at either end of a link whose formula is scaled by its probes (see
 /// `Linker::conditioned`).
 const MIN_COS: f32 = 0.2;
@@ -318,15 +324,16 @@ impl Linker<'_> {
         }
     }
 
-    /// Whether something hovers close in front of `node`: a sample (see `LeafData::hovered`), or
-    /// a sheltered node on one side (nodes over several sides count as sheltered, but their
+    /// Whether something hovers close in front of `node` and its probes cannot vouch for it: a
+    /// sample (see `LeafData::hovered`), or a sheltered node on one side of at most
+    /// [`HOVERED_MEMBERS`] members (nodes over several sides count as sheltered, but their
     /// probes span the sides).
     fn hovered(&self, node: Ref) -> bool {
         if node.is_leaf() {
             self.tree.leaf[node.index()].hovered
         } else {
             let n = &self.tree.nodes[node.index()];
-            n.sheltered && n.side != MULTI
+            n.sheltered && n.side != MULTI && n.count as usize <= HOVERED_MEMBERS
         }
     }
 
