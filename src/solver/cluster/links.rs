@@ -87,9 +87,10 @@ const EXHAUSTIVE: usize = 16;
 const NEGLIGIBLE: f64 = 0.25;
 /// Sheltered nodes of at most this many members are refined when their probes agree but did
 /// not see every pair: a fixture's outline crossing such a node leaves a few members of each
-/// kind, which eight probes can all miss. Larger ones keep their probes' verdict: on `cornell`
-/// the limit changes nothing down to 16 (seeds 1-10), while refining every sheltered node
-/// took 5.6 times the visibility queries at a million samples (docs/accuracy.md).
+/// kind, which eight probes can all miss. Larger ones keep their probes' verdict: refining
+/// every sheltered node took 5.6 times the visibility queries at a million samples, while on
+/// `cornell` a limit of 64 changed no figure and 16 moved seeds by up to 0.03% (at 2, seed 5's
+/// error of the probes came back; docs/accuracy.md).
 const HOVERED_MEMBERS: usize = 16;
 /// The least cosine at either end of a link whose formula is scaled by its probes (see
 /// `Linker::conditioned`).
