@@ -701,26 +701,31 @@ mod tests {
             .contains("index does not find"));
     }
 
-    #[test]
-    fn the_cluster_tree_is_valid_and_its_check_catches_broken_trees() {
-        let scene = small_room();
-        let vis = Backend::Bvh.build(&scene).unwrap();
+    /// A solve of `scene` with `rounds` adaptive rounds, and the cluster tree over its samples.
+    fn solve_and_tree(scene: &Scene, rounds: u32) -> (Solution, cluster::tree::Tree) {
+        let vis = Backend::Bvh.build(scene).unwrap();
         let options = Options {
-            rounds: 1,
+            rounds,
             ..Options::default()
         };
-        let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
-        let grid = TriangleGrid::new(&scene);
-        let lift = crate::visibility::lift(&scene);
+        let s = solve(scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
+        let grid = TriangleGrid::new(scene);
         let cx = Context {
-            scene: &scene,
+            scene,
             grid: &grid,
             samples: &s.samples,
             obstruction: &s.obstruction,
-            lift,
+            lift: crate::visibility::lift(scene),
         };
         let n = s.samples.len();
         let tree = cluster::tree::Tree::build(&s.samples, &vec![0.5; n], &vec![1.0; n], &cx);
+        (s, tree)
+    }
+
+    #[test]
+    fn the_cluster_tree_is_valid_and_its_check_catches_broken_trees() {
+        let (s, tree) = solve_and_tree(&small_room(), 1);
+        let n = s.samples.len();
         assert_eq!(tree.validate(&s.samples), Ok(()));
         assert_eq!(tree.nodes.len(), n - 1);
         // Nodes over several sides near the top, single-side subtrees below, and incoherent
@@ -752,22 +757,8 @@ mod tests {
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell/scene.toml"),
         )
         .unwrap();
-        let vis = Backend::Bvh.build(&scene).unwrap();
-        let options = Options {
-            rounds: 0,
-            ..Options::default()
-        };
-        let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
-        let grid = TriangleGrid::new(&scene);
-        let cx = Context {
-            scene: &scene,
-            grid: &grid,
-            samples: &s.samples,
-            obstruction: &s.obstruction,
-            lift: crate::visibility::lift(&scene),
-        };
+        let (s, tree) = solve_and_tree(&scene, 0);
         let n = s.samples.len();
-        let tree = cluster::tree::Tree::build(&s.samples, &vec![0.5; n], &vec![1.0; n], &cx);
         let (mut hovered, mut checked) = (0, 0);
         for k in 0..n {
             let (p, d) = (s.samples.position[k], s.samples.radius[k]);

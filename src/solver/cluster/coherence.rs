@@ -200,20 +200,7 @@ pub(crate) fn sheltered(
         (hi - pad).max(hi - pad + depth * normal),
     );
     let base = normal.dot(lo);
-    let mut poly: Vec<Vec3> = Vec::with_capacity(9);
-    let mut scratch: Vec<Vec3> = Vec::with_capacity(9);
-    cx.grid.any(blo, bhi, |t| {
-        let tri = &cx.scene.triangles[t as usize];
-        if tri.surface == surface {
-            return false;
-        }
-        poly.clear();
-        poly.extend_from_slice(&tri.vertices);
-        clip_half_space(&mut poly, &mut scratch, normal, base + cx.lift);
-        clip_half_space(&mut poly, &mut scratch, -normal, -(base + depth));
-        clip_box(&mut poly, &mut scratch, blo, bhi);
-        !poly.is_empty()
-    })
+    in_front(cx, surface, (normal, base), depth, (blo, bhi), |_| true)
 }
 
 /// Whether something hovers within `depth` in front of sample `k`, over the disc of its
@@ -227,22 +214,38 @@ pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
     let (lo, hi) = (p - half, p + half);
     let (blo, bhi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
     let base = n.dot(p);
-    let mut poly: Vec<Vec3> = Vec::with_capacity(9);
-    let mut scratch: Vec<Vec3> = Vec::with_capacity(9);
-    cx.grid.any(blo, bhi, |t| {
-        let tri = &cx.scene.triangles[t as usize];
+    in_front(cx, surface, (n, base), depth, (blo, bhi), |tri| {
         let lowest = tri
             .vertices
             .iter()
             .map(|v| n.dot(*v) - base)
             .fold(f32::INFINITY, f32::min);
-        if tri.surface == surface || lowest <= 2.0 * cx.lift {
+        lowest > 2.0 * cx.lift
+    })
+}
+
+/// Whether a triangle of another surface than `surface`, and one that `keep` accepts, has a
+/// part between the lift and `depth` in front of the plane n · x = base, inside the box.
+fn in_front(
+    cx: &Context,
+    surface: u32,
+    (n, base): (Vec3, f32),
+    depth: f32,
+    (lo, hi): (Vec3, Vec3),
+    keep: impl Fn(&crate::scene::Triangle) -> bool,
+) -> bool {
+    let mut poly: Vec<Vec3> = Vec::with_capacity(9);
+    let mut scratch: Vec<Vec3> = Vec::with_capacity(9);
+    cx.grid.any(lo, hi, |t| {
+        let tri = &cx.scene.triangles[t as usize];
+        if tri.surface == surface || !keep(tri) {
             return false;
         }
         poly.clear();
         poly.extend_from_slice(&tri.vertices);
+        clip_half_space(&mut poly, &mut scratch, n, base + cx.lift);
         clip_half_space(&mut poly, &mut scratch, -n, -(base + depth));
-        clip_box(&mut poly, &mut scratch, blo, bhi);
+        clip_box(&mut poly, &mut scratch, lo, hi);
         !poly.is_empty()
     })
 }
