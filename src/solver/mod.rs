@@ -7,6 +7,7 @@
 //! threshold of 0. Both build their form factors from `form_factor`, normalise rows
 //! (`normalise`) and run their heavy work on the same ordered pipeline (`pipeline`).
 
+mod balance;
 mod cluster;
 mod flat;
 mod form_factor;
@@ -415,6 +416,7 @@ fn solve_with(
         epsilon,
         reporter: Reporter::new(progress),
         ranks,
+        light_scale: glam::DVec3::ONE,
     };
 
     // Round 0: Poisson disk on every reflecting side.

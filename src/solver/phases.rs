@@ -9,7 +9,7 @@ use glam::{DVec3, Vec3};
 use super::cluster::coherence::{Context, TriangleGrid};
 use super::shooting::{Settings, State, Tick};
 use super::warm::{emission, reflectance};
-use super::{cluster, flat, normalise, warm};
+use super::{balance, cluster, flat, normalise, warm};
 use super::{Options, PhaseSeconds, RoundStats, ShootStats, Solution, StopReason};
 use crate::area::{self, AreaStats};
 use crate::error::Result;
@@ -40,6 +40,8 @@ pub(super) struct Solve<'a> {
     pub(super) ranks: &'a dyn crate::distributed::Ranks,
     /// The scene's specular surfaces and lights, where it has any (and the depth is not 0).
     pub(super) specular: Option<(Specular, Lights)>,
+    /// What the samples' direct light is scaled by to balance the lights' power (`balance`).
+    pub(super) light_scale: DVec3,
 }
 
 /// Samples an adaptive step (or the initial placement) added.
@@ -209,6 +211,26 @@ impl Solve<'_> {
         Ok(stats)
     }
 
+    /// The scale of the samples' direct light that balances it with the lights' power, in a
+    /// scene closed around its area lights and without specular surfaces (`balance`); 1
+    /// elsewhere. From the first samples' `arrivals`; later rounds' samples take it too.
+    fn balance(&self, solution: &Solution, arrivals: &[Arrival]) -> Result<DVec3> {
+        if self.specular.is_some() || self.reporter.stopped() {
+            return Ok(DVec3::ONE);
+        }
+        let settings = (self.options.seed, self.options.threads.max(1));
+        if !balance::closed_to_the_lights(self.scene, self.vis, self.lift, settings)? {
+            return Ok(DVec3::ONE);
+        }
+        let area = &solution.samples.area;
+        let received: DVec3 = arrivals
+            .iter()
+            .zip(area)
+            .map(|(a, &s)| a.irradiance * s)
+            .sum();
+        Ok(balance::scale(received, self.scene.emitted_power()))
+    }
+
     /// Direct light at the new samples, whether something covers them, and their warm start;
     /// the shadow queries made.
     fn direct_light(
@@ -271,6 +293,13 @@ impl Solve<'_> {
             let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
             (arrivals, queries, covered)
         };
+        let mut arrivals = arrivals;
+        if first_new == 0 {
+            self.light_scale = self.balance(solution, &arrivals)?;
+        }
+        for a in &mut arrivals {
+            a.irradiance *= self.light_scale;
+        }
         solution.covered.reserve_exact(covered.len());
         solution.covered.extend(covered);
         let mut queries = queries;
