@@ -67,14 +67,6 @@ fn surface_name(scene: &Scene, surface: u32) -> String {
     )
 }
 
-/// A unit direction, cosine-distributed about `n`.
-fn cosine_direction(n: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
-    let (u1, u2): (f32, f32) = (rng.random(), rng.random());
-    let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
-    let (t, b) = n.any_orthonormal_pair();
-    (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
-}
-
 /// A unit direction, uniform over the sphere.
 fn sphere_direction(rng: &mut Pcg64Mcg) -> Vec3 {
     let (u1, u2): (f32, f32) = (rng.random(), rng.random());
@@ -164,39 +156,10 @@ fn lights(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
         Ok(())
     };
     for (s, power) in scene.emitters() {
-        let surface = &scene.surfaces()[s as usize];
-        let triangles =
-            &scene.triangles()[surface.triangles.start as usize..surface.triangles.end as usize];
-        let area: f32 = triangles.iter().map(|t| t.area).sum();
-        if area <= 0.0 {
+        let rays = crate::light::leaving::rays(scene, s, LIGHT_RAYS, lift, &mut rng);
+        if rays.is_empty() {
             continue;
         }
-        let rays: Vec<Ray> = (0..LIGHT_RAYS)
-            .map(|_| {
-                let mut u = rng.random::<f32>() * area;
-                let t = triangles
-                    .iter()
-                    .find(|t| {
-                        u -= t.area;
-                        u <= 0.0
-                    })
-                    .unwrap_or(&triangles[triangles.len() - 1]);
-                let (a, b): (f32, f32) = (rng.random(), rng.random());
-                let (a, b) = if a + b > 1.0 {
-                    (1.0 - a, 1.0 - b)
-                } else {
-                    (a, b)
-                };
-                let [p, q, r] = t.vertices;
-                let x = p + (q - p) * a + (r - p) * b;
-                Ray {
-                    origin: x + lift * t.normal,
-                    dir: cosine_direction(t.normal, &mut rng),
-                    t_min: 0.0,
-                    t_max: f32::INFINITY,
-                }
-            })
-            .collect();
         cast(rays, power.max_element(), Some(s))?;
     }
     for source in scene.point_sources() {

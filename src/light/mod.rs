@@ -23,6 +23,7 @@ use crate::specular::shadow::{self, LightPath};
 use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
 
+pub(crate) mod leaving;
 mod spherical;
 
 /// Emitters subtending less than this (sr) from a receiver have their shadow rays drawn

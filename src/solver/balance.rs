@@ -6,13 +6,14 @@
 //! leaving the scene. Where the lights see only surfaces, the direct light is scaled to balance,
 //! as the row scales balance each receiver's form factors.
 
-use glam::{DVec3, Vec3};
-use rand::{RngExt, SeedableRng};
+use glam::DVec3;
+use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
 use crate::error::Result;
+use crate::light::leaving;
 use crate::scene::Scene;
-use crate::visibility::{Ray, Visibility};
+use crate::visibility::Visibility;
 
 /// Rays traced from each area light to see whether any of its light leaves the scene.
 pub(super) const RAYS_PER_LIGHT: usize = 1024;
@@ -35,40 +36,8 @@ pub(super) fn closed_to_the_lights(
     }
     let mut rays = Vec::new();
     for (s, _) in scene.emitters() {
-        let surface = &scene.surfaces[s as usize];
-        let triangles =
-            &scene.triangles[surface.triangles.start as usize..surface.triangles.end as usize];
-        let total: f32 = triangles.iter().map(|t| t.area).sum();
-        if total <= 0.0 {
-            continue;
-        }
-        let n = surface.normal;
-        let (u, v) = n.any_orthonormal_pair();
         let mut rng = Pcg64Mcg::seed_from_u64(seed ^ (0x6261_6c61_6e63_6500 + u64::from(s)));
-        for _ in 0..RAYS_PER_LIGHT {
-            // A point uniform over the light's area, a direction cosine-weighted about its normal.
-            let mut pick = rng.random::<f32>() * total;
-            let t = triangles
-                .iter()
-                .find(|t| {
-                    pick -= t.area;
-                    pick <= 0.0
-                })
-                .unwrap_or(&triangles[triangles.len() - 1]);
-            let (r1, r2) = (rng.random::<f32>().sqrt(), rng.random::<f32>());
-            let [a, b, c] = t.vertices;
-            let p = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
-            let (x1, x2) = (rng.random::<f32>(), rng.random::<f32>());
-            let (r, phi) = (x1.sqrt(), std::f32::consts::TAU * x2);
-            let dir: Vec3 =
-                u * (r * phi.cos()) + v * (r * phi.sin()) + n * (1.0 - x1).max(0.0).sqrt();
-            rays.push(Ray {
-                origin: p + lift * n,
-                dir,
-                t_min: 0.0,
-                t_max: f32::INFINITY,
-            });
-        }
+        rays.extend(leaving::rays(scene, s, RAYS_PER_LIGHT, lift, &mut rng));
     }
     let hits = crate::visibility::intersect_all(vis, &rays, threads)?;
     Ok(hits.iter().all(Option::is_some))

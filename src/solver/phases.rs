@@ -248,7 +248,7 @@ impl Solve<'_> {
             .map(|k| (s.position[k], s.normal[k]))
             .collect();
         let ids: Vec<u32> = (first_new as u32..n as u32).collect();
-        let (arrivals, queries, covered) = if self.reporter.stopped() {
+        let (mut arrivals, mut queries, covered) = if self.reporter.stopped() {
             (
                 vec![Arrival::default(); points.len()],
                 0,
@@ -293,7 +293,6 @@ impl Solve<'_> {
             let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
             (arrivals, queries, covered)
         };
-        let mut arrivals = arrivals;
         if first_new == 0 {
             self.light_scale = self.balance(solution, &arrivals)?;
         }
@@ -302,7 +301,6 @@ impl Solve<'_> {
         }
         solution.covered.reserve_exact(covered.len());
         solution.covered.extend(covered);
-        let mut queries = queries;
         if let (Some(transfer), Some((spec, lights))) = (
             solution.specular.as_mut().map(std::mem::take),
             &self.specular,
