@@ -22,6 +22,8 @@ pub enum Phase {
     Areas,
     /// Integrating direct light at the samples (solve) or the grid points (lux).
     DirectLight,
+    /// Sending photons from the lights through mirrors and glass (solve).
+    Photons,
     /// Probing hemispheres for the row sums, building the cluster tree and its links (solve).
     Links,
     /// Progressive shooting (solve, patches).
@@ -45,6 +47,7 @@ impl Phase {
             Phase::Sampling => "placing samples",
             Phase::Areas => "representative areas",
             Phase::DirectLight => "direct light",
+            Phase::Photons => "photons",
             Phase::Links => "links and row sums",
             Phase::Shooting => "shooting",
             Phase::Adaptive => "adding samples",

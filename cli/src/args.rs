@@ -87,6 +87,10 @@ pub struct Knobs {
     /// light that arrives by way of mirrors, glossy surfaces and glass).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::solver::MAX_SPECULAR_RAYS)))]
     pub specular_rays: Option<u32>,
+    /// Photons sent from the lights through curved mirrors and refracting solids (more: less
+    /// noise in the light they focus onto surfaces, the caustics).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=meshlight::solver::MAX_PHOTONS))]
+    pub photons: Option<u64>,
     /// Visibility backend: embree or bvh.
     #[arg(long)]
     pub backend: Option<Backend>,
@@ -205,7 +209,7 @@ pub struct SweepArgs {
     /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
     /// Keys: preset, epsilon, epsilon-scale, zeta, alpha, rounds, light-samples, tolerance, max-shots,
     /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
-    /// supersample, direct-rays, gather-rays, specular-depth, specular-rays, glossy-rays, patch-size, spp.
+    /// supersample, direct-rays, gather-rays, specular-depth, specular-rays, photons, glossy-rays, patch-size, spp.
     #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
     pub vary: Vec<(String, Vec<String>)>,
     /// How each run computes its image.
@@ -464,6 +468,7 @@ pub fn options_from(epsilon: Option<f32>, args: &Knobs) -> anyhow::Result<Option
     o.exact_visibility |= args.exact_visibility;
     o.specular_depth = args.specular_depth.unwrap_or(o.specular_depth);
     o.specular_rays = args.specular_rays.unwrap_or(o.specular_rays);
+    o.photons = args.photons.unwrap_or(o.photons);
     o.threads = args.threads.unwrap_or(o.threads).max(1);
     o.seed = args.seed.unwrap_or(o.seed);
     Ok(o)

@@ -19,9 +19,10 @@ pub fn explain(e: &anyhow::Error) -> String {
 
 /// The command-line flag of a library option, where there is one.
 fn flag(option: &str) -> Option<String> {
-    const FLAGS: [(&str, &str); 20] = [
+    const FLAGS: [(&str, &str); 21] = [
         ("gather_rays", "--gather-rays"),
         ("specular_rays", "--specular-rays"),
+        ("photons", "--photons"),
         ("specular_depth", "--specular-depth"),
         ("glossy_rays", "--glossy-rays"),
         ("epsilon", "--epsilon"),

@@ -41,12 +41,17 @@ const RAYS_PER_CALL: usize = 1 << 20;
 /// The golden ratio's fractional part: the Fibonacci lattice's second coordinate.
 const GOLDEN: f64 = 0.618_033_988_749_894_8;
 
-/// An area light: one emitting surface.
+/// An area light: one emitting surface, or a piece of many (a tessellated sphere or tube, see
+/// `scene::adjacency`).
 struct Emitter {
     triangles: Vec<[Vec3; 3]>,
     cumulative: Vec<f64>,
+    /// The plane of a planar emitter: unit normal (the front) and offset.
     normal: Vec3,
     offset: f32,
+    /// Per triangle, its front normal and plane offset, where the emitter is not one plane;
+    /// empty for a planar one.
+    facets: Vec<(Vec3, f32)>,
     ke: DVec3,
     /// Whether its front reflects light too (then it has samples of its own).
     reflects: bool,
@@ -77,6 +82,21 @@ pub struct DirectLight {
     specular: Option<(Specular, Vec<Chain>)>,
     /// Per chain, the emitters as seen through it (their mirror images).
     images: Vec<Vec<Emitter>>,
+    /// Whether the lights are reached straight too (not only through mirrors).
+    straight: bool,
+}
+
+/// Which ways to the lights a [`DirectLight`] takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Reach {
+    /// Straight, and through every chain of images listed.
+    All,
+    /// Straight, and through single reflectors: what the image traces at its pixels, where
+    /// shadows and reflections are sharpest.
+    Near,
+    /// Through chains of two reflectors or more only: the dimmer, farther images the samples
+    /// take whole and the image interpolates.
+    Far,
 }
 
 /// The straight way from a receiver to a light: no reflector.
@@ -101,31 +121,43 @@ impl DirectLight {
     /// Prepares the lights; `light_samples` shadow rays per area light and receiver.
     pub fn new(scene: &Scene, light_samples: u32) -> DirectLight {
         let emitters = scene
-            .emitters()
-            .map(|(s, _)| {
-                let surface = &scene.surfaces[s as usize];
-                let tris: Vec<[Vec3; 3]> = scene.triangles
-                    [surface.triangles.start as usize..surface.triangles.end as usize]
+            .emitter_groups()
+            .into_iter()
+            .map(|group| {
+                let triangles: Vec<&crate::scene::Triangle> = group
                     .iter()
-                    .map(|t| t.vertices)
+                    .flat_map(|&s| {
+                        let range = &scene.surfaces[s as usize].triangles;
+                        &scene.triangles[range.start as usize..range.end as usize]
+                    })
                     .collect();
                 let mut total = 0.0;
-                let cumulative = scene.triangles
-                    [surface.triangles.start as usize..surface.triangles.end as usize]
+                let cumulative = triangles
                     .iter()
                     .map(|t| {
                         total += f64::from(t.area);
                         total
                     })
                     .collect();
+                let tris: Vec<[Vec3; 3]> = triangles.iter().map(|t| t.vertices).collect();
+                let (first, material) = (group[0], scene.material_of(group[0]));
+                let surface = &scene.surfaces[first as usize];
                 Emitter {
                     bounds: bounds(&tris),
+                    facets: if group.len() > 1 {
+                        triangles
+                            .iter()
+                            .map(|t| (t.normal, t.normal.dot(t.vertices[0])))
+                            .collect()
+                    } else {
+                        Vec::new()
+                    },
                     triangles: tris,
                     cumulative,
                     normal: surface.normal,
                     offset: surface.offset,
-                    ke: scene.material_of(s).ke.as_dvec3(),
-                    reflects: scene.material_of(s).reflects_diffusely(),
+                    ke: material.ke.as_dvec3(),
+                    reflects: material.reflects_diffusely(),
                 }
             })
             .collect();
@@ -137,6 +169,7 @@ impl DirectLight {
             lift: crate::visibility::lift(scene),
             specular: None,
             images: Vec::new(),
+            straight: true,
         }
     }
 
@@ -145,10 +178,26 @@ impl DirectLight {
     /// lines (`specular::shadow`). A scene with none of them, or a depth of 0 (specular surfaces
     /// then block light), is lit as by [`DirectLight::new`].
     pub(crate) fn with_specular(scene: &Scene, light_samples: u32, depth: u32) -> DirectLight {
+        DirectLight::reaching(scene, light_samples, depth, Reach::All)
+    }
+
+    /// [`DirectLight::with_specular`] along some of the ways only (see [`Reach`]).
+    pub(crate) fn reaching(
+        scene: &Scene,
+        light_samples: u32,
+        depth: u32,
+        reach: Reach,
+    ) -> DirectLight {
         let mut light = DirectLight::new(scene, light_samples);
+        light.straight = reach != Reach::Far;
         let spec = Specular::of(scene);
         if depth > 0 && !spec.reflectors.is_empty() {
-            let chains = images::chains(&spec, depth);
+            let mut chains = images::chains(&spec, depth).chains;
+            chains.retain(|c| match reach {
+                Reach::All => true,
+                Reach::Near => c.reflectors.len() == 1,
+                Reach::Far => c.reflectors.len() > 1,
+            });
             light.images = chains
                 .iter()
                 .map(|c| {
@@ -156,16 +205,23 @@ impl DirectLight {
                         .emitters
                         .iter()
                         .map(|e| {
-                            let normal = (c.linear.transpose() * e.normal.as_dvec3()).as_vec3();
+                            let turn = |n: Vec3| (c.linear.transpose() * n.as_dvec3()).as_vec3();
+                            let normal = turn(e.normal);
                             let triangles: Vec<[Vec3; 3]> = e
                                 .triangles
                                 .iter()
                                 .map(|t| t.map(|v| c.image_of(&spec, v)))
                                 .collect();
+                            let facets = triangles
+                                .iter()
+                                .zip(&e.facets)
+                                .map(|(t, &(n, _))| (turn(n), turn(n).dot(t[0])))
+                                .collect();
                             Emitter {
                                 offset: normal.dot(triangles[0][0]),
                                 bounds: bounds(&triangles),
                                 normal,
+                                facets,
                                 triangles,
                                 cumulative: e.cumulative.clone(),
                                 ke: e.ke,
@@ -180,10 +236,19 @@ impl DirectLight {
         light
     }
 
-    /// The ways to the lights: straight, then each chain of reflectors.
-    fn ways(&self) -> impl Iterator<Item = Option<&Chain>> {
-        let chains = self.specular.iter().flat_map(|(_, c)| c.iter().map(Some));
-        std::iter::once(None).chain(chains)
+    /// The ways to the lights: straight (if it goes straight), then each chain of reflectors
+    /// with its index.
+    fn ways(&self) -> impl Iterator<Item = Option<(usize, &Chain)>> {
+        let chains = self
+            .specular
+            .iter()
+            .flat_map(|(_, c)| c.iter().enumerate().map(Some));
+        self.straight.then_some(None).into_iter().chain(chains)
+    }
+
+    /// Whether it takes no way at all (far images in a scene without any).
+    pub(crate) fn is_empty(&self) -> bool {
+        !self.straight && self.images.is_empty()
     }
 
     /// The share of light arriving along each path (1 or 0 without specular surfaces);
@@ -316,7 +381,7 @@ impl DirectLight {
             for source in &self.points {
                 for way in self.ways() {
                     let (p, chain) = match (way, &self.specular) {
-                        (Some(c), Some((spec, _))) if c.faces(spec, x) => {
+                        (Some((_, c)), Some((spec, _))) if c.faces(spec, x) => {
                             (c.image_of(spec, source.position), c.reflectors.as_slice())
                         }
                         (Some(_), _) => continue,
@@ -328,7 +393,7 @@ impl DirectLight {
                     if cos > 0.0 && r2 > 0.0 {
                         // The direction the light leaves in: the unfolded line's, reflected.
                         let leaving = match way {
-                            Some(c) => (c.linear * -d.as_dvec3()).as_vec3(),
+                            Some((_, c)) => (c.linear * -d.as_dvec3()).as_vec3(),
                             None => -d,
                         };
                         let intensity = source.towards(leaving).as_dvec3();
@@ -382,13 +447,15 @@ impl DirectLight {
         for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
             let from = x + self.lift * n;
             let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 2));
-            for (w, way) in self.ways().enumerate() {
+            for way in self.ways() {
+                // Slot 0 is the straight way, 1 + i chain i.
+                let w = way.map_or(0, |(i, _)| 1 + i);
                 let (emitters, chain) = match (way, &self.specular) {
-                    (Some(c), Some((spec, _))) => {
+                    (Some((i, c)), Some((spec, _))) => {
                         if !c.faces(spec, x) {
                             continue;
                         }
-                        (&self.images[w - 1], c.reflectors.as_slice())
+                        (&self.images[i], c.reflectors.as_slice())
                     }
                     _ => (&self.emitters, STRAIGHT),
                 };
@@ -445,6 +512,17 @@ impl DirectLight {
         (paths, rays): (&mut Vec<LightPath<'c>>, &mut Vec<(usize, f64)>),
         unoccluded: &mut f64,
     ) {
+        if !emitter.facets.is_empty() {
+            return self.facet_rays(
+                emitter,
+                (x, n, from),
+                (slot, chain, straight),
+                rng,
+                (analytic, factor, weights),
+                (paths, rays),
+                unoccluded,
+            );
+        }
         // Emitters light only what lies in front of them.
         let height = emitter.normal.dot(x) - emitter.offset;
         if height <= 0.0 {
@@ -526,6 +604,84 @@ impl DirectLight {
     }
 }
 
+impl DirectLight {
+    /// [`DirectLight::emitter_rays`] for an emitter of many planes (a sphere, a tube): the
+    /// analytic irradiance summed over the triangles facing x, and the shadow rays spread over
+    /// the triangles by their share of it (uniform over each triangle's area), so one ray budget
+    /// serves the whole light whatever its tessellation.
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn facet_rays<'c>(
+        &self,
+        emitter: &Emitter,
+        (x, n, from): (Vec3, Vec3, Vec3),
+        (slot, chain, straight): (usize, &'c [u32], bool),
+        rng: &mut Pcg64Mcg,
+        (analytic, factor, weights): (&mut [DVec3], &mut [f64], &mut [(f64, DVec3)]),
+        (paths, rays): (&mut Vec<LightPath<'c>>, &mut Vec<(usize, f64)>),
+        unoccluded: &mut f64,
+    ) {
+        // Per facing triangle: (triangle, its irradiance, cumulative irradiance).
+        let mut facing: Vec<(usize, f64, f64)> = Vec::new();
+        let mut irradiance = 0.0;
+        for (t, (tri, &(normal, offset))) in
+            emitter.triangles.iter().zip(&emitter.facets).enumerate()
+        {
+            if normal.dot(x) - offset <= 0.0 {
+                continue;
+            }
+            let e = polygon_irradiance(tri, x, n);
+            if e > 0.0 {
+                irradiance += e;
+                facing.push((t, e, irradiance));
+            }
+        }
+        if irradiance <= 0.0 {
+            return;
+        }
+        analytic[slot] = emitter.ke * irradiance;
+        if !emitter.reflects && straight {
+            factor[slot] = irradiance / std::f64::consts::PI;
+        }
+        *unoccluded += (emitter.ke * irradiance).element_sum();
+        let count = self.light_samples;
+        let shift = (rng.random::<f64>(), rng.random::<f64>());
+        for s in 0..count {
+            let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
+            let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
+            // The first coordinate picks a triangle by its irradiance; what is left of it and
+            // the second place the point uniformly inside.
+            let u = u1 * irradiance;
+            let k = facing
+                .partition_point(|&(_, _, c)| c <= u)
+                .min(facing.len() - 1);
+            let (t, e, end) = facing[k];
+            let within = ((u - (end - e)) / e).clamp(0.0, 1.0);
+            let [a, b, c] = emitter.triangles[t];
+            let (r1, r2) = (within.sqrt() as f32, u2 as f32);
+            let y = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
+            let normal = emitter.facets[t].0;
+            let d = y - x;
+            let dist2 = d.length_squared();
+            let (cos_x, cos_y) = (n.dot(d), -normal.dot(d));
+            if cos_x <= 0.0 || cos_y <= 0.0 || dist2 <= 0.0 {
+                continue;
+            }
+            // The integrand cos·cos/r² over the density (e/E)/A of the point, up to E.
+            let area = 0.5 * f64::from((b - a).cross(c - a).length());
+            let weight = f64::from(cos_x * cos_y / (dist2 * dist2)) * area / e;
+            weights[slot].0 += weight;
+            let to = y + self.lift * normal;
+            if let (Some(&k), Some((spec, _))) = (chain.first(), &self.specular) {
+                if !spec.reflectors[k as usize].may_pass(from, to) {
+                    continue;
+                }
+            }
+            paths.push(LightPath { from, to, chain });
+            rays.push((slot, weight));
+        }
+    }
+}
+
 /// Irradiance at x (normal n) from a triangle of unit radiance emitting towards x: Lambert's
 /// formula E = ½ Σ θ_i (n · Γ_i) over the triangle clipped to the half-space above x's plane.
 pub fn polygon_irradiance(t: &[Vec3; 3], x: Vec3, n: Vec3) -> f64 {
@@ -584,6 +740,54 @@ fn clipped_irradiance(polygon: &[Vec3], x: Vec3, n: Vec3, poly: &mut [DVec3]) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tessellated_sphere_light_is_one_light_seen_by_its_projected_area() {
+        // A ball of 320 emitting facets (radiance 1) in a dark room: one light, not 320. Far
+        // from it, its irradiance on a surface facing it is its projected area / d² (the
+        // facets' areas × their cosines towards the receiver, summed over the facets facing
+        // it; worked out here without Lambert's formula), to within (r/d)².
+        use crate::scene::fixtures::Parts;
+        let mut p = Parts::default();
+        let dark = p.material(crate::scene::Material::diffuse(
+            "dark",
+            Vec3::splat(0.5),
+            Vec3::ZERO,
+        ));
+        let lamp = p.material(crate::scene::Material::diffuse(
+            "lamp",
+            Vec3::ZERO,
+            Vec3::ONE,
+        ));
+        p.cuboid(Vec3::splat(-60.0), Vec3::splat(60.0), true, dark);
+        p.sphere(Vec3::ZERO, 0.5, 2, lamp);
+        let scene = p.scene(Vec3::new(0.0, 0.0, 50.0), Vec3::ZERO);
+        assert_eq!(scene.emitters().count(), 320);
+        let light = DirectLight::new(&scene, 16);
+        assert_eq!(light.emitters.len(), 1);
+        let vis = crate::visibility::Backend::Bvh.build(&scene).unwrap();
+        let d = 50.0f32;
+        for dir in [Vec3::Z, Vec3::new(1.0, 2.0, -0.5).normalize(), Vec3::NEG_Y] {
+            let projected: f64 = scene
+                .triangles
+                .iter()
+                .filter(|t| scene.material_of(t.surface).is_emitter())
+                .map(|t| f64::from(t.area) * f64::from(t.normal.dot(dir)).max(0.0))
+                .sum();
+            let expected = projected / f64::from(d * d);
+            let (arrivals, _) = light
+                .at(vis.as_ref(), &[(dir * d, -dir)], &[0], 1, 1, &mut |_| {
+                    crate::progress::Control::Continue
+                })
+                .unwrap();
+            let e = arrivals[0].irradiance.x;
+            assert!(
+                (e / expected - 1.0).abs() < 1e-3,
+                "{dir}: {e} against {expected}"
+            );
+            assert_eq!(arrivals[0].visible, 1.0);
+        }
+    }
 
     #[test]
     fn polygons_of_many_vertices_count_every_vertex() {

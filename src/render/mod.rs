@@ -16,7 +16,7 @@ mod paths;
 use glam::Vec3;
 
 use crate::error::Result;
-use crate::light::DirectLight;
+use crate::light::{DirectLight, Reach};
 use crate::progress::{Callback, Control, Phase, Progress, Reporter};
 use crate::sampling::{side_of, surface_of, Side};
 use crate::scene::Scene;
@@ -28,6 +28,10 @@ use interpolate::{Interpolator, Site};
 
 /// Edge pixels of high contrast get up to this many times `supersample` rays per side.
 const MAX_EDGE_BOOST: usize = 4;
+
+/// In scenes with specular surfaces, a pixel whose neighbour is brighter or darker by more
+/// than this many times the image's mean is supersampled like an edge.
+const CONTRAST_EDGE: f64 = 1.0;
 
 /// Rendering settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -297,7 +301,10 @@ pub fn render_distributed(
 
         // Edge pixels, refined with more rays.
         let edges = if all && options.supersample > 1 {
-            edge_pixels(&centre, w, h, options.supersample as usize)
+            // In mirrors and on glossy surfaces an edge need not be one between sides: a
+            // light's highlight can be smaller than a pixel.
+            let contrast = shader.paths.is_some();
+            edge_pixels(&centre, w, h, options.supersample as usize, contrast)
         } else {
             Edges::default()
         };
@@ -373,18 +380,27 @@ struct Edges {
 }
 
 /// Edge pixels: a neighbour, diagonal ones included (a corner may cut a pixel whose four
-/// nearest neighbours all see what it sees), sees another side. Each gets `n` rays per side,
-/// more where the edge's contrast is high (the rim of a light): a jittered grid's coverage
-/// error scales with the contrast.
-fn edge_pixels(centre: &[(Vec3, u32)], w: usize, h: usize, n: usize) -> Edges {
-    let pixels: Vec<usize> = (0..w * h)
-        .filter(|&p| neighbours(p, w, h).any(|q| centre[q].1 != centre[p].1))
-        .collect();
+/// nearest neighbours all see what it sees), sees another side; with `contrast`, also one
+/// whose brightest channel differs from the pixel's by more than [`CONTRAST_EDGE`] × the
+/// image's mean (a highlight or a light in a mirror, smaller than a pixel). Each gets `n` rays
+/// per side, more where the edge's contrast is high (the rim of a light): a jittered grid's
+/// coverage error scales with the contrast.
+fn edge_pixels(centre: &[(Vec3, u32)], w: usize, h: usize, n: usize, contrast: bool) -> Edges {
     let mean = centre
         .iter()
         .map(|c| f64::from(c.0.element_sum()))
         .sum::<f64>()
         / (3 * w * h) as f64;
+    let step = (CONTRAST_EDGE * mean) as f32;
+    let pixels: Vec<usize> = (0..w * h)
+        .filter(|&p| {
+            let here = centre[p].0.max_element();
+            neighbours(p, w, h).any(|q| {
+                centre[q].1 != centre[p].1
+                    || (contrast && (centre[q].0.max_element() - here).abs() > step)
+            })
+        })
+        .collect();
     let per_side: Vec<usize> = pixels
         .iter()
         .map(|&p| {
@@ -575,7 +591,7 @@ impl<'a> Shader<'a> {
         let light = match options.direct {
             // A solution without its samples' direct light cannot be split.
             Direct::Traced { light_samples } if solution.direct.len() == s.len() => Some(
-                DirectLight::with_specular(scene, light_samples, solution.specular_depth),
+                DirectLight::reaching(scene, light_samples, solution.specular_depth, Reach::Near),
             ),
             _ => None,
         };
@@ -627,13 +643,12 @@ impl<'a> Shader<'a> {
             Vec::new()
         };
         let penumbra = match options.direct {
-            Direct::Traced { light_samples } if light.is_some() => {
-                Some(DirectLight::with_specular(
-                    scene,
-                    (light_samples * PENUMBRA_RAYS).min(crate::light::MAX_LIGHT_SAMPLES),
-                    solution.specular_depth,
-                ))
-            }
+            Direct::Traced { light_samples } if light.is_some() => Some(DirectLight::reaching(
+                scene,
+                (light_samples * PENUMBRA_RAYS).min(crate::light::MAX_LIGHT_SAMPLES),
+                solution.specular_depth,
+                Reach::Near,
+            )),
             _ => None,
         };
         Shader {

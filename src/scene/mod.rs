@@ -2,8 +2,11 @@
 //! and a camera, loaded from a scene file (TOML + OBJ/MTL, `docs/scene-format.md`) or built
 //! from parts by a host program.
 
+pub(crate) mod adjacency;
 mod camera;
 mod file;
+#[cfg(test)]
+pub(crate) mod fixtures;
 mod gltf;
 mod grid;
 mod luminaire;
@@ -738,6 +741,12 @@ impl Scene {
             m.is_emitter()
                 .then(|| (i as u32, std::f64::consts::PI * m.ke.as_dvec3() * s.area))
         })
+    }
+
+    /// The area lights as lights are sampled: lists of emitting surfaces, each a light (see
+    /// `adjacency::emitter_groups`).
+    pub(crate) fn emitter_groups(&self) -> Vec<Vec<u32>> {
+        adjacency::emitter_groups(self)
     }
 
     /// Power emitted by all area lights and point lights (W, RGB).

@@ -28,7 +28,7 @@ pub use crate::area::AreaStats;
 use crate::budget::{human_bytes, human_count, human_number, BYTES_PER_SAMPLE};
 use crate::error::{Error, Result};
 pub use crate::light::Arrival;
-use crate::light::DirectLight;
+use crate::light::{DirectLight, Reach};
 use crate::progress::Reporter;
 pub use crate::progress::{Control, Phase, Progress};
 pub use crate::sampling::Samples;
@@ -38,7 +38,7 @@ pub use crate::specular::MAX_SPECULAR_DEPTH;
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
 pub use options::{
-    Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH,
+    Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH, MAX_PHOTONS,
     MAX_SPECULAR_RAYS,
 };
 use phases::{AddedSamples, Solve};
@@ -405,7 +405,19 @@ fn solve_with(
         scene,
         vis,
         options,
-        light: DirectLight::with_specular(scene, options.light_samples, options.specular_depth),
+        light: DirectLight::reaching(
+            scene,
+            options.light_samples,
+            options.specular_depth,
+            Reach::Near,
+        ),
+        far_light: Some(DirectLight::reaching(
+            scene,
+            options.light_samples,
+            options.specular_depth,
+            Reach::Far,
+        ))
+        .filter(|far| !far.is_empty()),
         specular: {
             let spec = crate::specular::Specular::of(scene);
             (spec.any() && options.specular_depth > 0)
@@ -550,6 +562,12 @@ fn check(options: &Options) -> Result<()> {
                 "{} must lie in 1..={MAX_SPECULAR_RAYS}",
                 options.specular_rays
             ),
+        );
+    }
+    if options.photons == 0 || options.photons > MAX_PHOTONS {
+        return fail(
+            "photons",
+            format!("{} must lie in 1..={MAX_PHOTONS}", options.photons),
         );
     }
     if options.specular_depth > crate::specular::MAX_SPECULAR_DEPTH {

@@ -72,6 +72,13 @@ pub struct Options {
     /// less noise in the light that arrives by way of mirrors, glossy surfaces and glass, at
     /// proportional cost. Unused in scenes without specular materials.
     pub specular_rays: u32,
+    /// Photons sent from the lights towards mirrors and glass, 1 to [`MAX_PHOTONS`], where the
+    /// mirror images do not carry all their light: curved mirrors, refracting solids (a glass
+    /// ball, a block), chains of flat mirrors beyond the images listed. Where they land is
+    /// spread over the samples' areas: the light focused onto diffuse surfaces (caustics).
+    /// More gives less noise in that light, at proportional cost; unused where the images carry
+    /// it all (flat mirrors and panes in rooms with few of them).
+    pub photons: u64,
     /// Worker threads (≥ 1). Results do not depend on it.
     pub threads: usize,
     /// Jobs in flight in the solver's pipeline at most (≥ 1): bounds the memory the pipeline
@@ -87,8 +94,11 @@ pub const AUTO_SAMPLES: f64 = 4000.0;
 /// The most chains per sample [`Options::specular_rays`] may ask for.
 pub const MAX_SPECULAR_RAYS: u32 = 4096;
 
+/// The most photons [`Options::photons`] may ask for.
+pub const MAX_PHOTONS: u64 = 1 << 30;
+
 /// The default [`Options::specular_depth`].
-pub const DEFAULT_SPECULAR_DEPTH: u32 = 8;
+pub const DEFAULT_SPECULAR_DEPTH: u32 = 32;
 
 /// The default [`Options::cluster_threshold`].
 pub const DEFAULT_CLUSTER_THRESHOLD: f64 = 0.05;
@@ -110,6 +120,7 @@ impl Default for Options {
             memory_budget: DEFAULT_MEMORY_BUDGET,
             specular_depth: DEFAULT_SPECULAR_DEPTH,
             specular_rays: 64,
+            photons: 1_000_000,
             threads: std::thread::available_parallelism()
                 .map_or(2, |n| n.get())
                 .min(8),

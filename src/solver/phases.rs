@@ -30,7 +30,10 @@ pub(super) struct Solve<'a> {
     pub(super) scene: &'a Scene,
     pub(super) vis: &'a dyn Visibility,
     pub(super) options: &'a Options,
+    /// The lights, straight and through single reflectors (what the image traces again).
     pub(super) light: DirectLight,
+    /// The lights through chains of two reflectors or more, where the scene has any.
+    pub(super) far_light: Option<DirectLight>,
     /// The scene's triangles for the hierarchy's coherence tests (none for the flat solver).
     pub(super) grid: Option<TriangleGrid>,
     pub(super) lift: f32,
@@ -53,6 +56,51 @@ pub(super) struct AddedSamples {
     pub(super) seconds: f64,
     /// Per side: whether it has new samples or changed radii (`None`: every side is new).
     pub(super) changed: Option<Vec<bool>>,
+}
+
+/// Direct light from `light` at the samples `points` (position, normal) with ids `ids`, each
+/// rank a run of them in the light's own chunks, all-gathered; the shadow queries over all
+/// ranks.
+fn arrive(
+    light: &DirectLight,
+    vis: &dyn Visibility,
+    ranks: &dyn crate::distributed::Ranks,
+    (points, ids): (&[(Vec3, Vec3)], &[u32]),
+    (seed, threads): (u64, usize),
+    report: crate::parallel::Report,
+) -> Result<(Vec<Arrival>, u64)> {
+    let mine = crate::distributed::share_of(ranks, points.len(), DirectLight::CHUNK);
+    let (part, queries) = light.at(
+        vis,
+        &points[mine.clone()],
+        &ids[mine.clone()],
+        seed,
+        threads,
+        report,
+    )?;
+    let mut arrivals = vec![Arrival::default(); points.len()];
+    arrivals[mine].copy_from_slice(&part);
+    drop(part);
+    crate::distributed::gather_shares(
+        ranks,
+        &mut arrivals,
+        DirectLight::CHUNK,
+        |a: &Arrival| {
+            [
+                a.irradiance.x,
+                a.irradiance.y,
+                a.irradiance.z,
+                f64::from(a.visible),
+                a.dark_emitters,
+            ]
+        },
+        |v| Arrival {
+            irradiance: DVec3::new(v[0], v[1], v[2]),
+            visible: v[3] as f32,
+            dark_emitters: v[4],
+        },
+    )?;
+    Ok((arrivals, crate::distributed::sum_over(ranks, queries)?))
 }
 
 impl Solve<'_> {
@@ -256,40 +304,16 @@ impl Solve<'_> {
             )
         } else {
             let base = self.base(Phase::DirectLight, round, n);
-            // Each rank a run of the samples, in the light's own chunks.
-            let ranks = self.ranks;
-            let mine = crate::distributed::share_of(ranks, points.len(), DirectLight::CHUNK);
-            let (part, queries) = self.light.at(
+            let at = (points.as_slice(), ids.as_slice());
+            let mut report = self.reporter.part(base);
+            let (arrivals, queries) = arrive(
+                &self.light,
                 vis,
-                &points[mine.clone()],
-                &ids[mine.clone()],
-                options.seed,
-                threads,
-                &mut self.reporter.part(base),
+                self.ranks,
+                at,
+                (options.seed, threads),
+                &mut report,
             )?;
-            let mut arrivals = vec![Arrival::default(); points.len()];
-            arrivals[mine].copy_from_slice(&part);
-            drop(part);
-            crate::distributed::gather_shares(
-                ranks,
-                &mut arrivals,
-                DirectLight::CHUNK,
-                |a: &Arrival| {
-                    [
-                        a.irradiance.x,
-                        a.irradiance.y,
-                        a.irradiance.z,
-                        f64::from(a.visible),
-                        a.dark_emitters,
-                    ]
-                },
-                |v| Arrival {
-                    irradiance: DVec3::new(v[0], v[1], v[2]),
-                    visible: v[3] as f32,
-                    dark_emitters: v[4],
-                },
-            )?;
-            let queries = crate::distributed::sum_over(ranks, queries)?;
             let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
             (arrivals, queries, covered)
         };
@@ -315,10 +339,60 @@ impl Solve<'_> {
             );
             queries += if self.reporter.stopped() {
                 transfer.direct.resize(n, DVec3::ZERO);
+                transfer.specular_share.resize(n, 0.0);
                 0
             } else {
                 transfer.follow(scene, solution, vis, (spec, lights), settings, first_new)?
             };
+            // The lights seen through two reflectors or more: taken whole, not interpolated.
+            if let Some(far) = &self.far_light {
+                let base = self.base(Phase::DirectLight, round, n);
+                let at = (points.as_slice(), ids.as_slice());
+                let (part, q) = if self.reporter.stopped() {
+                    (vec![Arrival::default(); points.len()], 0)
+                } else {
+                    let mut report = self.reporter.part(base);
+                    arrive(
+                        far,
+                        vis,
+                        self.ranks,
+                        at,
+                        (options.seed, threads),
+                        &mut report,
+                    )?
+                };
+                queries += q;
+                transfer.far.extend(part.iter().map(|a| a.irradiance));
+            }
+            // Photons: sent once, spread over each round's areas. Old samples take the change
+            // their new areas make; new ones start from theirs (`warm`).
+            if first_new == 0 && !self.reporter.stopped() {
+                let base = self.base(Phase::Photons, round, n);
+                let settings = (
+                    options.photons,
+                    options.specular_depth,
+                    options.seed,
+                    threads,
+                );
+                let mut report = self.reporter.part(base);
+                queries +=
+                    transfer.trace_photons(scene, vis, (spec, lights), settings, &mut report)?;
+            }
+            let caustic = if transfer.landings.is_empty() || self.reporter.stopped() {
+                let mut kept = transfer.caustic.clone();
+                kept.resize(n, DVec3::ZERO);
+                kept
+            } else {
+                transfer.deposit(solution)
+            };
+            for (k, new) in caustic.iter().enumerate().take(first_new) {
+                let change = *new - transfer.caustic.get(k).copied().unwrap_or_default();
+                let rho = reflectance(scene, &solution.samples, k);
+                solution.irradiance[k] += change;
+                solution.unshot[k] += rho * change;
+                solution.radiosity[k] += rho * change;
+            }
+            transfer.caustic = caustic;
             solution.specular = Some(transfer);
         }
         warm::start(
@@ -334,7 +408,10 @@ impl Solve<'_> {
         if round == 0 {
             // Direct light that reached no sample area left the scene.
             let received: DVec3 = (0..n)
-                .map(|k| solution.direct[k].irradiance * solution.samples.area[k])
+                .map(|k| {
+                    let exact = solution.direct[k].irradiance + warm::specular_direct(solution, k);
+                    exact * solution.samples.area[k]
+                })
                 .sum();
             solution.ledger.escaped += solution.ledger.emitted - received;
         }
@@ -367,6 +444,18 @@ impl Solve<'_> {
             )?
         };
         solution.closed.reserve_exact(probes.len());
+        // A hemisphere that shows specular surfaces (to the chains, if not to the probes) is not
+        // all links': its row must not be scaled up to the whole of it.
+        let shows_specular = |k: usize| {
+            let t = solution.specular.as_ref();
+            t.and_then(|t| t.specular_share.get(k))
+                .is_some_and(|&s| s > 0.0)
+        };
+        let probes: Vec<bool> = probes
+            .into_iter()
+            .enumerate()
+            .map(|(i, closed)| closed && !shows_specular(first_new + i))
+            .collect();
         solution.closed.extend(probes);
         solution.row_scale.reserve_exact(n - first_new);
         let hierarchical = self.grid.is_some();

@@ -15,6 +15,7 @@ use crate::scene::Scene;
 use crate::specular::gather::{Chains, End};
 use crate::specular::highlight::Highlights;
 use crate::specular::lights::Lights;
+use crate::specular::photons::{self, Landing};
 use crate::specular::Specular;
 use crate::visibility::Visibility;
 
@@ -25,6 +26,9 @@ pub(crate) struct Transfer {
     pub ends: Vec<End>,
     /// Per sample: irradiance from the lights by way of glossy bounces.
     pub direct: Vec<DVec3>,
+    /// Per sample: the share of its hemisphere (cosine-weighted, as its chains found it) whose
+    /// first hit is specular: there its light comes through G, not through links.
+    pub specular_share: Vec<f32>,
     /// G by receiver (compressed rows): row i is `entries[starts[i]..starts[i + 1]]`, each
     /// (sample, irradiance at i per unit radiosity of the sample, RGB).
     starts: Vec<u32>,
@@ -34,6 +38,13 @@ pub(crate) struct Transfer {
     columns: Vec<(u32, [f32; 3])>,
     /// Per shooter: the flux its unit radiosity delivers through G, Σᵢ Gᵢⱼ Sᵢ.
     pub column_flux: Vec<DVec3>,
+    /// Where photons landed (`specular::photons`), traced once.
+    pub landings: Vec<Landing>,
+    /// Per sample: the irradiance the photons bring, their power over its area.
+    pub caustic: Vec<DVec3>,
+    /// Per sample: the direct light through chains of two reflectors or more (the image
+    /// interpolates it: `light::Reach`).
+    pub far: Vec<DVec3>,
 }
 
 fn rgb(w: [f32; 3]) -> DVec3 {
@@ -80,6 +91,7 @@ impl Transfer {
             Ok(())
         })?;
         self.direct.resize(first, DVec3::ZERO);
+        self.specular_share.resize(first, 0.0);
         let mut queries = 0;
         for (c, f) in found.into_iter().enumerate() {
             let base = (first + c * CHUNK) as u32;
@@ -88,9 +100,102 @@ impl Transfer {
                 e
             }));
             self.direct.extend(f.direct);
+            self.specular_share.extend(f.specular_share);
             queries += f.queries;
         }
         Ok(queries)
+    }
+
+    /// Sends the photons (where the scene needs them) and keeps their landings; the queries.
+    pub(crate) fn trace_photons(
+        &mut self,
+        scene: &Scene,
+        vis: &dyn Visibility,
+        (spec, lights): (&Specular, &Lights),
+        (count, depth, seed, threads): (u64, u32, u64, usize),
+        report: crate::parallel::Report,
+    ) -> Result<u64> {
+        let listing = crate::specular::images::chains(spec, depth);
+        if !photons::needed(scene, spec, &listing) {
+            return Ok(0);
+        }
+        let pass = photons::Photons::new(scene, (spec, &listing, lights), vis, count, depth);
+        let found = pass.trace(seed, threads, report)?;
+        self.landings = found.landings;
+        Ok(found.queries)
+    }
+
+    /// The irradiance the photons bring to each sample of `solution`: the power landing in each
+    /// area cell is split among the samples as the cell's area is (eq. 5), and each sample's
+    /// power is over its area. So a sample's irradiance is the photons' average over the very
+    /// region its area stands for, and a uniform irradiance comes out uniform.
+    pub(crate) fn deposit(&self, solution: &Solution) -> Vec<DVec3> {
+        let s = &solution.samples;
+        let mut cell_power = vec![DVec3::ZERO; s.cells.len()];
+        let mut loose = vec![DVec3::ZERO; s.len()];
+        // The landings side by side, each side's cells found by their grid keys.
+        let mut order: Vec<usize> = (0..self.landings.len()).collect();
+        order.sort_by_key(|&i| self.landings[i].side);
+        let mut keys: Vec<(u64, u32)> = Vec::new();
+        let mut side = u32::MAX;
+        let mut grid = None;
+        for i in order {
+            let landing = &self.landings[i];
+            let map = &solution.maps[crate::sampling::surface_of(landing.side) as usize];
+            if landing.side != side {
+                side = landing.side;
+                let cell = 2.0 * s.cell_half.get(side as usize).copied().unwrap_or(0.0);
+                grid = (cell > 0.0).then(|| {
+                    let nx = ((map.max.x - map.min.x) / cell).floor() as u64 + 2;
+                    (cell, nx)
+                });
+                keys.clear();
+                if let Some((cell, nx)) = grid {
+                    let key = |p: glam::Vec2| {
+                        let q = ((p - map.min) / cell).floor().max(glam::Vec2::ZERO);
+                        q.y as u64 * nx + q.x as u64
+                    };
+                    keys.extend(
+                        s.cells_of(side)
+                            .map(|c| (key(map.to_2d(s.cells[c].centroid)), c as u32)),
+                    );
+                    keys.sort_unstable();
+                }
+            }
+            let power = Vec3::from(landing.power).as_dvec3();
+            let uv = map.to_2d(landing.point);
+            let found = grid.and_then(|(cell, nx)| {
+                let q = ((uv - map.min) / cell).floor().max(glam::Vec2::ZERO);
+                let key = q.y as u64 * nx + q.x as u64;
+                let at = keys.partition_point(|&(k, _)| k < key);
+                keys.get(at).filter(|&&(k, _)| k == key).map(|&(_, c)| c)
+            });
+            match found {
+                Some(c) => cell_power[c as usize] += power,
+                // Off every cell (at a rim, by rounding): to the nearest sample.
+                None => {
+                    if let Some(k) = solution.index.nearest(s, landing.side, uv) {
+                        loose[k as usize] += power;
+                    }
+                }
+            }
+        }
+        let whole = f64::from(crate::sampling::CELL_UNITS);
+        (0..s.len())
+            .map(|k| {
+                let power: DVec3 = s
+                    .shares
+                    .of(k)
+                    .map(|(c, units)| cell_power[c as usize] * (f64::from(units) / whole))
+                    .sum::<DVec3>()
+                    + loose[k];
+                if s.area[k] > 0.0 {
+                    power / s.area[k]
+                } else {
+                    DVec3::ZERO
+                }
+            })
+            .collect()
     }
 
     /// G from the ends, interpolating the samples of `solution` there; returns the queries.
@@ -194,10 +299,112 @@ impl Transfer {
         use crate::sampling::vec_bytes;
         vec_bytes(&self.ends)
             + vec_bytes(&self.direct)
+            + vec_bytes(&self.specular_share)
             + vec_bytes(&self.starts)
             + vec_bytes(&self.entries)
             + vec_bytes(&self.column_starts)
             + vec_bytes(&self.columns)
             + vec_bytes(&self.column_flux)
+            + vec_bytes(&self.landings)
+            + vec_bytes(&self.caustic)
+            + vec_bytes(&self.far)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::{solve, Control, Options};
+    use crate::visibility::Backend;
+
+    #[test]
+    fn photons_landing_evenly_give_every_sample_the_same_irradiance() {
+        // Landings spread evenly over the room's floor, 4 × 4 at the centres of a sub-grid of
+        // every area cell, of equal power: each full cell receives the same power per area, so
+        // a sample whose region is made of full cells gets exactly the floor's power over the
+        // landings' area, whatever its radius, and the floor's samples together get it all.
+        let scene = crate::scene::Scene::load(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/room/scene.toml"),
+        )
+        .unwrap();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let options = Options {
+            epsilon: Some(0.4),
+            rounds: 1,
+            ..Options::default()
+        };
+        let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
+        let samples = &s.samples;
+        assert!(samples.round.contains(&1), "adaptive samples too");
+        // The floor: the largest side facing up.
+        let side = (0..2 * scene.surfaces.len() as u32)
+            .filter(|&side| {
+                !samples.cells_of(side).is_empty() && {
+                    let surface = &scene.surfaces[crate::sampling::surface_of(side) as usize];
+                    surface.normal.y > 0.99 && !crate::sampling::is_back(side)
+                }
+            })
+            .max_by(|&a, &b| {
+                let area = |side| scene.surfaces[crate::sampling::surface_of(side) as usize].area;
+                area(a).total_cmp(&area(b))
+            })
+            .unwrap();
+        let map = &s.maps[crate::sampling::surface_of(side) as usize];
+        let cell = 2.0 * samples.cell_half[side as usize];
+        let (nx, ny) = (
+            ((map.max.x - map.min.x) / cell).ceil() as usize * 4,
+            ((map.max.y - map.min.y) / cell).ceil() as usize * 4,
+        );
+        let mut landings = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                let uv = map.min + (glam::Vec2::new(i as f32, j as f32) + 0.5) * (cell / 4.0);
+                if map.contains(uv) {
+                    landings.push(Landing {
+                        point: map.to_3d(uv),
+                        side,
+                        power: [1.0; 3],
+                    });
+                }
+            }
+        }
+        let power = landings.len() as f64;
+        let per_area = power / (landings.len() as f64 * f64::from(cell / 4.0).powi(2));
+        let transfer = Transfer {
+            landings,
+            ..Transfer::default()
+        };
+        let e = transfer.deposit(&s);
+        let on_floor: Vec<usize> = (0..samples.len())
+            .filter(|&k| samples.side[k] == side)
+            .collect();
+        let total: f64 = on_floor.iter().map(|&k| e[k].x * samples.area[k]).sum();
+        assert!((total / power - 1.0).abs() < 1e-9, "{total} of {power}");
+        assert!(on_floor.iter().all(|&k| e[k].x > 0.0));
+        let full = f64::from(cell * cell);
+        let mut checked = 0;
+        for &k in &on_floor {
+            if samples
+                .shares_of(k)
+                .all(|(c, _)| (f64::from(samples.cells[c as usize].area) / full - 1.0).abs() < 1e-4)
+            {
+                checked += 1;
+                assert!(
+                    (e[k].x / per_area - 1.0).abs() < 1e-3,
+                    "sample {k} (radius {}): {} against {per_area}",
+                    samples.radius[k],
+                    e[k].x
+                );
+            }
+        }
+        assert!(
+            checked > on_floor.len() / 2,
+            "{checked} of {}",
+            on_floor.len()
+        );
+        assert!(e
+            .iter()
+            .enumerate()
+            .all(|(k, e)| samples.side[k] == side || *e == DVec3::ZERO));
     }
 }

@@ -33,13 +33,15 @@ pub(crate) fn emission(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
     std::f64::consts::PI * scene.material_of(surface_of(side)).ke.as_dvec3()
 }
 
-/// Sample k's light from the lights by way of glossy bounces (0 without specular surfaces).
-fn specular_direct(solution: &Solution, k: usize) -> DVec3 {
-    solution
-        .specular
-        .as_ref()
-        .and_then(|t| t.direct.get(k).copied())
-        .unwrap_or(DVec3::ZERO)
+/// Sample k's light from the lights by way of specular surfaces that is not interpolated: by
+/// glossy bounces, through chains of images, and the photons' (0 without specular surfaces).
+pub(crate) fn specular_direct(solution: &Solution, k: usize) -> DVec3 {
+    solution.specular.as_ref().map_or(DVec3::ZERO, |t| {
+        [&t.direct, &t.far, &t.caustic]
+            .iter()
+            .map(|v| v.get(k).copied().unwrap_or_default())
+            .sum()
+    })
 }
 
 /// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their

@@ -26,14 +26,18 @@ use crate::scene::Scene;
 use crate::visibility::{Ray, Visibility};
 
 /// A highlight sample drawn: (receiver, plane, light: area index `Err` or point index `Ok`,
-/// light point, ray).
-type Drawn = (u32, usize, Result<usize, usize>, Vec3, Ray);
+/// light point and the light's normal there, ray).
+type Drawn = (u32, usize, Result<usize, usize>, (Vec3, Vec3), Ray);
 
 /// The golden ratio's fractional part: the Fibonacci lattice's second coordinate.
 const GOLDEN: f64 = 0.618_033_988_749_894_8;
 
 /// Chains whose weight falls below this share of their start are not followed further.
 const NEGLIGIBLE: f64 = 1e-4;
+
+/// A delta branch carrying less than this share of its bounce's light is followed with the
+/// probability its share over this (Russian roulette).
+const ROULETTE: f64 = 0.25;
 
 /// Where a chain ends on a surface with samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,6 +73,8 @@ pub(crate) struct Found {
     pub ends: Vec<End>,
     /// Per receiver: irradiance from the lights by way of glossy bounces.
     pub direct: Vec<DVec3>,
+    /// Per receiver: the share of its rays whose first hit is specular.
+    pub specular_share: Vec<f32>,
     pub queries: u64,
 }
 
@@ -166,9 +172,9 @@ impl Chains<'_> {
                 let points = (0..self.lights.point_sources().len()).map(Ok);
                 for light in areas.chain(points) {
                     for _ in 0..m {
-                        let l = match light {
+                        let (l, normal) = match light {
                             Err(i) => self.lights.point_on(i, rng.random(), rng.random()),
-                            Ok(j) => self.lights.point_sources()[j].position,
+                            Ok(j) => (self.lights.point_sources()[j].position, Vec3::ZERO),
                         };
                         let (u1, u2) = (rng.random(), rng.random());
                         let Some(omega) = plane.draw(from, l, u1, u2) else {
@@ -181,7 +187,7 @@ impl Chains<'_> {
                             r as u32,
                             p,
                             light,
-                            l,
+                            (l, normal),
                             Ray {
                                 origin: from,
                                 dir: omega.as_vec3(),
@@ -196,8 +202,8 @@ impl Chains<'_> {
         let rays: Vec<Ray> = drawn.iter().map(|d| d.4).collect();
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(&rays, &mut hits)?;
-        let lights: Vec<(usize, f64, DVec3, Vec3)> = self.lights.area_lights().collect();
-        for ((r, p, light, l, ray), hit) in drawn.iter().zip(&hits) {
+        let lights: Vec<(usize, f64, DVec3)> = self.lights.area_lights().collect();
+        for ((r, p, light, (l, normal), ray), hit) in drawn.iter().zip(&hits) {
             let plane = &self.highlights.planes[*p];
             let Some(hit) = hit else { continue };
             let tri = &self.scene.triangles[hit.triangle as usize];
@@ -219,7 +225,8 @@ impl Chains<'_> {
             let density = plane.density(ray.origin, *l, omega);
             let (to, contribution) = match *light {
                 Err(i) => {
-                    let (_, area, ke, normal) = lights[i];
+                    let (_, area, ke) = lights[i];
+                    let normal = *normal;
                     let to = *l + self.lights.lift() * normal;
                     let d = (*l - y).as_dvec3();
                     let dist2 = d.length_squared();
@@ -268,6 +275,7 @@ impl Chains<'_> {
         let mut found = Found {
             ends: Vec::new(),
             direct: vec![DVec3::ZERO; receivers.len()],
+            specular_share: vec![0.0; receivers.len()],
             queries: 0,
         };
         let k = self.rays.max(1);
@@ -317,8 +325,11 @@ impl Chains<'_> {
                 let specular = self.spec.specular[tri.surface as usize];
                 // A chain starts at a specular surface: what is diffuse from the receiver is
                 // the links'.
-                if l.depth == 0 && !specular {
-                    continue;
+                if l.depth == 0 {
+                    if !specular {
+                        continue;
+                    }
+                    found.specular_share[l.receiver as usize] += share as f32;
                 }
                 let dir = l.ray.dir.normalize();
                 let back = dir.dot(tri.normal) > 0.0;
@@ -367,10 +378,23 @@ impl Chains<'_> {
                 match branches(material, dir.as_dvec3(), tri.normal.as_dvec3(), two_sided) {
                     Branches::None => {}
                     Branches::Delta(list) => {
+                        let all: f64 = list.iter().flatten().map(|(_, w)| w.max_element()).sum();
                         for (j, (d, w)) in list.iter().flatten().enumerate() {
-                            let weight = l.weight * *w;
+                            let mut weight = l.weight * *w;
                             if weight.max_element() < NEGLIGIBLE * share {
                                 continue;
+                            }
+                            // A faint branch (glass's reflection beside its refraction) goes on
+                            // at random, its weight raised by as much: a chain through a glass
+                            // ball would otherwise end at every one of its inner bounces.
+                            let kept = w.max_element() / (ROULETTE * all);
+                            if kept < 1.0 {
+                                let u = Pcg64Mcg::seed_from_u64(side_seed(l.rng, j as u32, 37))
+                                    .random::<f64>();
+                                if u >= kept {
+                                    continue;
+                                }
+                                weight /= kept;
                             }
                             next.push(Link {
                                 ray: Ray {

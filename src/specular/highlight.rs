@@ -40,7 +40,8 @@ impl Highlights {
         for (i, surface) in scene.surfaces.iter().enumerate() {
             let m = &scene.materials[surface.material as usize];
             if let Kind::Specular { ks, roughness } = m.kind {
-                if roughness > 0.0 && ks.max_element() > 0.0 && spec.specular[i] {
+                if roughness > 0.0 && ks.max_element() > 0.0 && spec.specular[i] && !spec.curved[i]
+                {
                     let alpha = f64::from(roughness * roughness).max(1e-4);
                     let half_angle = (3.0 * alpha).clamp(0.01, 1.0);
                     h.of_surface[i] = Some(h.planes.len() as u32);
@@ -48,6 +49,7 @@ impl Highlights {
                         surface: i as u32,
                         reflector: Reflector {
                             surface: i as u32,
+                            area: surface.area as f32,
                             normal: surface.normal,
                             offset: surface.offset,
                             reflects: Reflects::Mirror(ks),
@@ -116,6 +118,7 @@ mod tests {
             surface: 0,
             reflector: Reflector {
                 surface: 0,
+                area: 1.0,
                 normal: Vec3::Y,
                 offset: 0.0,
                 reflects: Reflects::Mirror(Vec3::ONE),

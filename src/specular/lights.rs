@@ -8,13 +8,14 @@ use glam::{DVec3, Vec3};
 use crate::material::Lobe;
 use crate::scene::{PointSource, Scene};
 
-/// An emitting surface to sample.
+/// An area light to sample: an emitting surface, or a piece of many (`scene::adjacency`).
 struct AreaLight {
     triangles: Vec<[Vec3; 3]>,
+    /// Per triangle, its front normal.
+    normals: Vec<Vec3>,
     cumulative: Vec<f64>,
     area: f64,
     ke: DVec3,
-    normal: Vec3,
 }
 
 /// The scene's lights, for sampling from glossy vertices.
@@ -37,24 +38,31 @@ impl Lights {
     pub(crate) fn new(scene: &Scene) -> Lights {
         let mut of_surface = vec![None; scene.surfaces.len()];
         let mut areas = Vec::new();
-        for (s, _) in scene.emitters() {
-            let surface = &scene.surfaces[s as usize];
-            let range = surface.triangles.start as usize..surface.triangles.end as usize;
+        for group in scene.emitter_groups() {
+            let triangles: Vec<&crate::scene::Triangle> = group
+                .iter()
+                .flat_map(|&s| {
+                    let range = &scene.surfaces[s as usize].triangles;
+                    &scene.triangles[range.start as usize..range.end as usize]
+                })
+                .collect();
             let mut total = 0.0;
-            let cumulative = scene.triangles[range.clone()]
+            let cumulative = triangles
                 .iter()
                 .map(|t| {
                     total += f64::from(t.area);
                     total
                 })
                 .collect();
-            of_surface[s as usize] = Some(areas.len() as u32);
+            for &s in &group {
+                of_surface[s as usize] = Some(areas.len() as u32);
+            }
             areas.push(AreaLight {
-                triangles: scene.triangles[range].iter().map(|t| t.vertices).collect(),
+                triangles: triangles.iter().map(|t| t.vertices).collect(),
+                normals: triangles.iter().map(|t| t.normal).collect(),
                 cumulative,
                 area: total,
-                ke: scene.material_of(s).ke.as_dvec3(),
-                normal: surface.normal,
+                ke: scene.material_of(group[0]).ke.as_dvec3(),
             });
         }
         Lights {
@@ -97,14 +105,14 @@ impl Lights {
         for light in &self.areas {
             for _ in 0..count {
                 let (u1, u2) = uniforms();
-                let y = light.point(u1, u2);
+                let (y, normal) = light.point(u1, u2);
                 let d = (y - v).as_dvec3();
                 let dist2 = d.length_squared();
                 if dist2 <= 0.0 {
                     continue;
                 }
                 let dir = d / dist2.sqrt();
-                let cos_y = -dir.dot(light.normal.as_dvec3());
+                let cos_y = -dir.dot(normal.as_dvec3());
                 if cos_y <= 0.0 || dir.dot(lobe.normal()) <= 0.0 {
                     continue;
                 }
@@ -119,7 +127,7 @@ impl Lights {
                     third(y, Some(pdf_light)),
                 );
                 out.push(LightSample {
-                    to: y + self.lift * light.normal,
+                    to: y + self.lift * normal,
                     radiance: light.ke * f / (f64::from(count) * pdf_light) * weight,
                 });
             }
@@ -187,16 +195,25 @@ impl Lights {
         )
     }
 
-    /// The area lights: (index, area, Ke, normal).
-    pub(crate) fn area_lights(&self) -> impl Iterator<Item = (usize, f64, DVec3, Vec3)> + '_ {
+    /// The area lights: (index, area, Ke).
+    pub(crate) fn area_lights(&self) -> impl Iterator<Item = (usize, f64, DVec3)> + '_ {
         self.areas
             .iter()
             .enumerate()
-            .map(|(i, a)| (i, a.area, a.ke, a.normal))
+            .map(|(i, a)| (i, a.area, a.ke))
     }
 
-    /// A point on area light `i`, at (u1, u2).
-    pub(crate) fn point_on(&self, i: usize, u1: f64, u2: f64) -> Vec3 {
+    /// The box around area light `i`, as its centre and half its diagonal.
+    pub(crate) fn bounds_of(&self, i: usize) -> (Vec3, f32) {
+        let (lo, hi) = self.areas[i].triangles.iter().flatten().fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), &v| (lo.min(v), hi.max(v)),
+        );
+        (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+    }
+
+    /// A point on area light `i`, at (u1, u2), and the light's front normal there.
+    pub(crate) fn point_on(&self, i: usize, u1: f64, u2: f64) -> (Vec3, Vec3) {
         self.areas[i].point(u1, u2)
     }
 
@@ -212,9 +229,9 @@ impl Lights {
 }
 
 impl AreaLight {
-    /// The point at (u1, u2): u1 along the cumulative area picks the triangle, the rest places
-    /// the point uniformly inside.
-    fn point(&self, u1: f64, u2: f64) -> Vec3 {
+    /// The point at (u1, u2), and the normal there: u1 along the cumulative area picks the
+    /// triangle, the rest places the point uniformly inside.
+    fn point(&self, u1: f64, u2: f64) -> (Vec3, Vec3) {
         let u = u1 * self.area;
         let t = self
             .cumulative
@@ -224,7 +241,10 @@ impl AreaLight {
         let within = ((u - start) / (self.cumulative[t] - start)).clamp(0.0, 1.0);
         let [a, b, c] = self.triangles[t];
         let (r1, r2) = (within.sqrt() as f32, u2 as f32);
-        a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
+        (
+            a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2),
+            self.normals[t],
+        )
     }
 }
 

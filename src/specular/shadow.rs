@@ -123,7 +123,9 @@ pub(crate) fn arriving(
                     w.entered = None;
                 }
                 _ => match spec.glass[surface as usize] {
-                    Some((ior, filter, thin)) if w.crossings < MAX_CROSSINGS => {
+                    Some((ior, filter, thin))
+                        if spec.straight[surface as usize] && w.crossings < MAX_CROSSINGS =>
+                    {
                         let ior = f64::from(ior);
                         let filter = filter.as_dvec3();
                         let passed = if thin {
