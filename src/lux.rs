@@ -243,6 +243,10 @@ impl SpecularGather<'_> {
     ) -> Result<Vec<DVec3>> {
         let has_samples = |side| self.interpolator.has_samples(side);
         let highlights = Highlights::of(self.scene, &self.spec);
+        // No photon lands on a grid point: its chains take the lights they meet where the
+        // images do not carry them (through curved mirrors and refracting solids).
+        let listing = crate::specular::images::chains(&self.spec, self.depth);
+        let tree = crate::specular::images::ChainTree::new(&listing.chains, false);
         let chains = Chains {
             scene: self.scene,
             spec: &self.spec,
@@ -253,6 +257,7 @@ impl SpecularGather<'_> {
             rays: self.rays,
             has_samples: &has_samples,
             highlights: &highlights,
+            unlisted: Some(&tree),
         };
         let receivers: Vec<(Vec3, Vec3, u32)> = points
             .iter()

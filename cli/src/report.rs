@@ -77,9 +77,15 @@ pub fn info(scene: &Scene) -> String {
             .map(|&(i, _)| scene.surfaces()[i as usize].area)
             .sum::<f64>();
     let power: DVec3 = emitters.iter().map(|&(_, p)| p).sum();
+    let lights = scene.area_light_count();
+    let grouped = if lights == emitters.len() {
+        String::new()
+    } else {
+        format!(" in {lights} light(s)")
+    };
     let _ = writeln!(
         s,
-        "area lights   {} surface(s), area {:.6}, power {} W",
+        "area lights   {} surface(s){grouped}, area {:.6}, power {} W",
         emitters.len(),
         area,
         rgb(power)
@@ -148,6 +154,22 @@ pub fn info(scene: &Scene) -> String {
         c.width,
         c.height
     );
+    let sp = meshlight::solver::specular_summary(scene, meshlight::solver::DEFAULT_SPECULAR_DEPTH);
+    if sp.flat_reflectors + sp.curved_facets + sp.refracting_faces + sp.glossy_surfaces > 0 {
+        let _ =
+            writeln!(
+            s,
+            "specular      {} flat reflector(s), {} curved facet(s), {} refracting glass face(s), \
+             {} glossy surface(s); images through {} chain(s){}; photons {}",
+            sp.flat_reflectors,
+            sp.curved_facets,
+            sp.refracting_faces,
+            sp.glossy_surfaces,
+            sp.chains,
+            if sp.chains_complete { "" } else { " (the rest by photons)" },
+            if sp.photons { "yes" } else { "no (the images carry it all)" }
+        );
+    }
     match scene.solver_defaults().epsilon {
         Some(e) => {
             let _ = writeln!(s, "solver        epsilon {e} (scene file)");

@@ -743,6 +743,12 @@ impl Scene {
         })
     }
 
+    /// How many area lights the emitting surfaces make: each surface one, but pieces of eight
+    /// or more joined along edges (a tessellated sphere or tube) one each.
+    pub fn area_light_count(&self) -> usize {
+        self.emitter_groups().len()
+    }
+
     /// The area lights as lights are sampled: lists of emitting surfaces, each a light (see
     /// `adjacency::emitter_groups`).
     pub(crate) fn emitter_groups(&self) -> Vec<Vec<u32>> {

@@ -34,7 +34,7 @@ pub use crate::progress::{Control, Phase, Progress};
 pub use crate::sampling::Samples;
 use crate::sampling::{reflecting_sides, surface_of, Obstruction, SideIndex, SurfaceMap};
 use crate::scene::Scene;
-pub use crate::specular::MAX_SPECULAR_DEPTH;
+pub use crate::specular::{summary as specular_summary, SpecularSummary, MAX_SPECULAR_DEPTH};
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
 pub use options::{

@@ -78,6 +78,7 @@ impl Transfer {
             rays,
             has_samples: &has_samples,
             highlights: &highlights,
+            unlisted: None,
         };
         let receivers: Vec<(Vec3, Vec3, u32)> = (first..n)
             .map(|k| (s.position[k], s.normal[k], k as u32))

@@ -15,6 +15,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::highlight::Highlights;
+use super::images::ChainTree;
 use super::lights::{LightSample, Lights};
 use super::shadow::{self, LightPath};
 use super::Specular;
@@ -92,6 +93,10 @@ pub(crate) struct Chains<'a> {
     pub has_samples: &'a (dyn Fn(Side) -> bool + Sync),
     /// The glossy planes highlights are drawn on.
     pub highlights: &'a Highlights,
+    /// Where chains also take the light of area lights they meet after mirrors and glass
+    /// alone, unless the images carry that path (the tree of their chains): for grid points,
+    /// which no photon lands on. `None` for samples, whose photons carry it.
+    pub unlisted: Option<&'a ChainTree>,
 }
 
 /// Highlight samples per receiver, glossy plane and light: one for every eight chains.
@@ -123,9 +128,35 @@ struct Link {
     /// Set when the lobe that cast it was a first bounce on a glossy plane.
     first: Option<FirstBounce>,
     rng: u64,
+    /// Whether the images carry its path so far: crossings of glass only where shadow rays
+    /// pass straight, and reflections (their node in [`Chains::unlisted`]'s tree) a listed
+    /// chain.
+    straight: bool,
+    node: u32,
 }
 
 impl Chains<'_> {
+    /// Whether the images carry a chain after it reflects (`reflected`) on or crosses
+    /// `surface` from its back or front: (straight so far, its node in the tree of chains).
+    fn carried(&self, l: &Link, surface: u32, back: bool, reflected: bool) -> (bool, u32) {
+        let Some(tree) = self.unlisted else {
+            return (false, ChainTree::OFF);
+        };
+        let s = surface as usize;
+        if reflected {
+            match self.spec.reflector_of[s] {
+                Some(r) if !back || self.spec.reflectors[r as usize].both_sides => {
+                    (l.straight, tree.step(l.node, r))
+                }
+                // Inside a slab: its inner bounces are the straight way's.
+                _ if back && self.spec.straight[s] => (l.straight, l.node),
+                _ => (false, ChainTree::OFF),
+            }
+        } else {
+            (l.straight && self.spec.straight[s], l.node)
+        }
+    }
+
     /// The highlight strategy's density for the path receiver → first bounce → light point
     /// `light`, relative to the light samples' (× their density, for area lights): the
     /// cone's density × highlight samples, over the gather's rays × cos θ/π at the receiver.
@@ -307,6 +338,8 @@ impl Chains<'_> {
                     lobe_pdf: None,
                     first: None,
                     rng: side_seed(seed, id, 29 + u64::from(s)),
+                    straight: true,
+                    node: ChainTree::ROOT,
                 });
             }
         }
@@ -345,6 +378,12 @@ impl Chains<'_> {
                             normal: if back { -tri.normal } else { tri.normal },
                             weight: l.weight,
                         });
+                    }
+                    if let Some(tree) = self.unlisted.filter(|_| !l.glossy) {
+                        if !back && material.is_emitter() && !(l.straight && tree.listed(l.node)) {
+                            found.direct[l.receiver as usize] +=
+                                std::f64::consts::PI * l.weight * material.ke.as_dvec3();
+                        }
                     }
                     if l.glossy && !back && material.is_emitter() {
                         let mis = l.lobe_pdf.map_or(1.0, |pdf| {
@@ -396,6 +435,9 @@ impl Chains<'_> {
                                 }
                                 weight /= kept;
                             }
+                            // The first branch is the reflection, the second the
+                            // crossing (`material::branches`).
+                            let (straight, node) = self.carried(l, tri.surface, back, j == 0);
                             next.push(Link {
                                 ray: Ray {
                                     origin: off(*d),
@@ -411,6 +453,8 @@ impl Chains<'_> {
                                 lobe_pdf: None,
                                 first: None,
                                 rng: side_seed(l.rng, j as u32, 31),
+                                straight,
+                                node,
                             });
                         }
                     }
@@ -464,6 +508,8 @@ impl Chains<'_> {
                                     lobe_pdf: Some(lobe.pdf(d)),
                                     first,
                                     rng: side_seed(l.rng, 7, 37),
+                                    straight: false,
+                                    node: ChainTree::OFF,
                                 });
                             }
                         }

@@ -99,6 +99,59 @@ pub(crate) fn chains(spec: &Specular, depth: u32) -> Listing {
     Listing { chains, complete }
 }
 
+/// The listed chains as a tree of reflectors, to follow a path's reflections one at a time
+/// and know at its end whether the images carry it.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ChainTree {
+    /// (node, reflector) → the node one reflector further.
+    next: std::collections::HashMap<(u32, u32), u32>,
+    /// Per node: whether its reflectors, in order, are a listed chain.
+    listed: Vec<bool>,
+}
+
+impl ChainTree {
+    /// No reflection yet: the straight way, which the direct light carries.
+    pub(crate) const ROOT: u32 = 0;
+    /// Reflections no listed chain begins with.
+    pub(crate) const OFF: u32 = u32::MAX;
+
+    /// The tree of `chains` read from the receiver (`from_light` false: as listed, nearest the
+    /// receiver first) or from the light (reversed).
+    pub(crate) fn new(chains: &[Chain], from_light: bool) -> ChainTree {
+        let mut tree = ChainTree {
+            next: std::collections::HashMap::new(),
+            listed: vec![true],
+        };
+        for chain in chains {
+            let mut node = Self::ROOT;
+            let order: Vec<u32> = if from_light {
+                chain.reflectors.iter().rev().copied().collect()
+            } else {
+                chain.reflectors.clone()
+            };
+            for r in order {
+                let fresh = tree.listed.len() as u32;
+                node = *tree.next.entry((node, r)).or_insert(fresh);
+                if node == fresh {
+                    tree.listed.push(false);
+                }
+            }
+            tree.listed[node as usize] = true;
+        }
+        tree
+    }
+
+    /// The node after reflecting on reflector `r` at `node`.
+    pub(crate) fn step(&self, node: u32, r: u32) -> u32 {
+        self.next.get(&(node, r)).copied().unwrap_or(Self::OFF)
+    }
+
+    /// Whether the reflections that led to `node` are a listed chain (or none).
+    pub(crate) fn listed(&self, node: u32) -> bool {
+        self.listed.get(node as usize).copied().unwrap_or(false)
+    }
+}
+
 /// Whether reflector `next` can follow `chain` on a straight line unfolded across the chain's
 /// mirrors: each reflector must stand (partly) on the reflecting side of the one before it and
 /// that one on its own, and, unfolded, `next`'s window must lie (partly) behind the plane of
@@ -228,6 +281,33 @@ mod tests {
         assert_eq!(three.len(), 28, "{three:?}");
         assert_eq!(listing.chains.len(), 4 + 4 * 3 + 28);
         assert!(listing.complete);
+    }
+
+    #[test]
+    fn the_tree_of_chains_knows_a_listed_chain_read_either_way() {
+        let spec = Specular {
+            reflectors: box_walls(0.9),
+            ..Specular::default()
+        };
+        let listing = chains(&spec, 2);
+        for from_light in [false, true] {
+            let tree = ChainTree::new(&listing.chains, from_light);
+            let walk = |path: &[u32]| {
+                path.iter()
+                    .fold(ChainTree::ROOT, |node, &r| tree.step(node, r))
+            };
+            assert!(tree.listed(ChainTree::ROOT));
+            for c in &listing.chains {
+                let mut path = c.reflectors.clone();
+                if from_light {
+                    path.reverse();
+                }
+                assert!(tree.listed(walk(&path)), "{path:?}");
+            }
+            // Longer than listed, or a wall twice in a row: not carried.
+            assert!(!tree.listed(walk(&[0, 1, 0])));
+            assert!(!tree.listed(walk(&[2, 2])));
+        }
     }
 
     #[test]

@@ -232,6 +232,52 @@ impl Specular {
     }
 }
 
+/// How a scene's specular surfaces carry light (`docs/method.md` §22), as `meshlight info`
+/// reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct SpecularSummary {
+    /// Flat mirrors, panes and glass faces: they make mirror images of the lights.
+    pub flat_reflectors: usize,
+    /// Facets of curved mirrors and glass (a tessellated ball's): they make no images.
+    pub curved_facets: usize,
+    /// Faces of glass solids shadow rays do not pass straight (a block, a ball: not a slab or
+    /// a pane).
+    pub refracting_faces: usize,
+    /// Glossy surfaces (rough mirrors): their light comes by the chains' light sampling.
+    pub glossy_surfaces: usize,
+    /// Chains of images listed (at most 64), and whether they are all the chains that carry
+    /// light.
+    pub chains: usize,
+    /// Whether every chain that carries light is listed.
+    pub chains_complete: bool,
+    /// Whether photons carry light the images do not.
+    pub photons: bool,
+}
+
+/// How `scene`'s specular surfaces carry light at specular depth `depth`.
+pub fn summary(scene: &Scene, depth: u32) -> SpecularSummary {
+    let spec = Specular::of(scene);
+    let listing = images::chains(&spec, depth);
+    let n = scene.surfaces.len();
+    SpecularSummary {
+        flat_reflectors: spec.reflectors.len(),
+        curved_facets: (0..n).filter(|&s| spec.specular[s] && spec.curved[s]).count(),
+        refracting_faces: (0..n)
+            .filter(|&s| spec.glass[s].is_some() && !spec.straight[s])
+            .count(),
+        glossy_surfaces: (0..n)
+            .filter(|&s| {
+                spec.specular[s]
+                    && matches!(scene.material_of(s as u32).kind, Kind::Specular { roughness, .. } if roughness > 0.0)
+            })
+            .count(),
+        chains: listing.chains.len(),
+        chains_complete: listing.complete,
+        photons: depth > 0 && photons::needed(scene, &spec, &listing),
+    }
+}
+
 /// Per surface: whether it is a facet of a curved specular surface, and whether shadow rays
 /// pass it straight (see [`Specular::straight`]).
 fn shapes(scene: &Scene) -> (Vec<bool>, Vec<bool>) {

@@ -16,13 +16,11 @@
 //! reproduced exactly and the bias is the areas' own blur, which adaptive rounds shrink where
 //! the caustic's light changes.
 
-use std::collections::HashSet;
-
 use glam::{DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::images::Listing;
+use super::images::{ChainTree, Listing};
 use super::lights::Lights;
 use super::Specular;
 use crate::error::Result;
@@ -108,8 +106,8 @@ pub(crate) struct Photons<'a> {
     vis: &'a dyn Visibility,
     lift: f32,
     depth: u32,
-    /// The chains of images listed, as reflector sequences from the light's side (reversed).
-    listed: HashSet<Vec<u32>>,
+    /// The chains of images listed, read from the light.
+    listed: ChainTree,
     /// Per surface: its target, if it is a mirror or glass.
     target_of: Vec<Option<u32>>,
     targets: Vec<Target>,
@@ -128,8 +126,8 @@ struct Flight {
     bounces: u32,
     /// Whether the images carry its path so far (given its reflections are a listed chain).
     straight: bool,
-    /// The reflectors it reflected on, from the light's side.
-    reflections: Vec<u32>,
+    /// Where its reflections so far lead in the tree of listed chains.
+    node: u32,
     rng: Pcg64Mcg,
 }
 
@@ -188,11 +186,7 @@ impl<'a> Photons<'a> {
             vis,
             lift,
             depth,
-            listed: listing
-                .chains
-                .iter()
-                .map(|c| c.reflectors.iter().rev().copied().collect())
-                .collect(),
+            listed: ChainTree::new(&listing.chains, true),
             target_of,
             targets,
             pairs,
@@ -329,7 +323,7 @@ impl<'a> Photons<'a> {
             target: pair.target,
             bounces: 0,
             straight: true,
-            reflections: Vec::new(),
+            node: ChainTree::ROOT,
             rng,
         })
     }
@@ -400,7 +394,7 @@ impl<'a> Photons<'a> {
         if reflected {
             match self.spec.reflector_of[s] {
                 Some(r) if !back || self.spec.reflectors[r as usize].both_sides => {
-                    f.reflections.push(r)
+                    f.node = self.listed.step(f.node, r)
                 }
                 _ if back && self.spec.straight[s] => {}
                 _ => f.straight = false,
@@ -431,7 +425,7 @@ impl<'a> Photons<'a> {
     /// Whether the images carry a photon's path so far: straight through glass, and its
     /// reflections a listed chain (or none).
     fn carried(&self, f: &Flight) -> bool {
-        f.straight && (f.reflections.is_empty() || self.listed.contains(&f.reflections))
+        f.straight && self.listed.listed(f.node)
     }
 }
 
