@@ -161,7 +161,7 @@ fn glossy_plates_under_sphere_lights_match_the_path_tracer() {
     // Within 2.5% over blocks. Blocks that see a light directly are left out: the smallest
     // light is a third of a pixel across at this size, which the path tracer's random points
     // in the pixel find and the meshless render's pixel centres miss (a light of a pixel or
-    // more is found by the edge rays, as at the scene's own size). Measured: 0.75% (2.9%
+    // more is found by the edge rays, as at the scene's own size). Measured: 1.3% (2.9%
     // before pixels of high contrast were supersampled: the sharpest highlights are smaller
     // than a pixel too).
     let scene = shipped("veach", "scene.toml", 96, 64);

@@ -167,7 +167,7 @@ pub fn info(scene: &Scene) -> String {
             sp.glossy_surfaces,
             sp.chains,
             if sp.chains_complete { "" } else { " (the rest by photons)" },
-            if sp.photons { "yes" } else { "no (the images carry it all)" }
+            if sp.photons { "yes" } else { "no" }
         );
     }
     match scene.solver_defaults().epsilon {

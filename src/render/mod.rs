@@ -703,7 +703,7 @@ impl<'a> Shader<'a> {
         share: u32,
     ) -> Result<u64> {
         if let Some(paths) = &self.paths {
-            return self.shade_paths(paths, rays, first_id, out);
+            return self.shade_paths(paths, rays, first_id, out, share);
         }
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(rays, &mut hits)?;

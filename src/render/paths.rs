@@ -63,14 +63,17 @@ struct Shadowed {
 }
 
 impl Shader<'_> {
-    /// [`Shader::shade`] in a scene with specular surfaces.
+    /// [`Shader::shade`] in a scene with specular surfaces; `share` rays of a pixel share its
+    /// glossy fans (a supersampled pixel's rays draw fewer directions each, as many in all).
     pub(super) fn shade_paths(
         &self,
         paths: &Paths,
         rays: &[Ray],
         first_id: u32,
         out: &mut [(Vec3, u32)],
+        share: u32,
     ) -> Result<u64> {
+        let fan = (paths.glossy_rays / share.max(1)).max(1);
         let lift = self.lift;
         let mut radiance = vec![DVec3::ZERO; rays.len()];
         let mut sides = vec![u32::MAX; rays.len()];
@@ -201,7 +204,7 @@ impl Shader<'_> {
                         ));
                         let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
                         // A fan of directions at the first glossy bounce, one at later ones.
-                        let n = if b.glossed { 1 } else { paths.glossy_rays };
+                        let n = if b.glossed { 1 } else { fan };
                         self.glossy(n, b, &lobe, from, &mut uniforms, &mut next);
                         samples.clear();
                         paths
