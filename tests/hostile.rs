@@ -644,3 +644,83 @@ fn options_drawn_from_the_extremes_end_in_a_result_or_an_error_and_hear_a_stop()
         },
     );
 }
+
+// --- Rooms of mirrors and glass that once listed chains of images without end. ---
+
+/// A 2 m cube of `walls` with a 0.4 m panel light under its ceiling, and `inside` added.
+fn mirrored(walls: meshlight::scene::Material, inside: impl FnOnce(&mut Builder)) -> Scene {
+    let mut b = Builder::default();
+    let walls = b.material(walls);
+    let light = b.material(material("light", 0.0, 10.0));
+    b.room(Vec3::ZERO, Vec3::splat(2.0), walls, &[]);
+    b.quad(
+        [
+            Vec3::new(0.8, 1.99, 0.8),
+            Vec3::new(1.2, 1.99, 0.8),
+            Vec3::new(1.2, 1.99, 1.2),
+            Vec3::new(0.8, 1.99, 1.2),
+        ],
+        light,
+    );
+    inside(&mut b);
+    b.scene(camera(
+        Vec3::new(1.0, 1.0, 0.1),
+        Vec3::new(1.0, 0.8, 2.0),
+        12,
+    ))
+}
+
+#[test]
+fn rooms_of_mirrors_and_a_lamp_in_dense_glass_end_with_an_answer() {
+    // Every wall a lossless mirror (a diffuse box the only thing that keeps light), and a lamp
+    // inside a closed glass box of index 10 (R = 0.67 at normal incidence, nearly all of it
+    // caught by total internal reflection): both listed chains of images without end.
+    isolated(
+        "rooms_of_mirrors_and_a_lamp_in_dense_glass_end_with_an_answer",
+        || {
+            let all_mirrors = mirrored(common::specular("mirror", 0.0, 1.0, 0.0), |b| {
+                let grey = b.material(material("grey", 0.5, 0.0));
+                b.solid(Vec3::new(0.7, 0.0, 0.7), Vec3::new(1.3, 0.6, 1.3), grey);
+            });
+            let glass_box = mirrored(material("white", 0.7, 0.0), |b| {
+                let dense = b.material(common::glass("dense", 10.0, false));
+                b.solid(Vec3::splat(0.6), Vec3::new(1.4, 1.995, 1.4), dense);
+            });
+            for (name, scene) in [("mirrors", all_mirrors), ("dense glass", glass_box)] {
+                for backend in Backend::available() {
+                    let vis = backend.build(&scene).unwrap();
+                    let s = meshlight::solve(&scene, vis.as_ref(), &quick(), &mut go).unwrap();
+                    let (image, _) = meshlight::render(
+                        &scene,
+                        &s,
+                        vis.as_ref(),
+                        &RenderOptions::default(),
+                        &mut go,
+                    )
+                    .unwrap();
+                    let mean = image.mean();
+                    assert!(mean.is_finite() && mean > 0.0, "{name}, {backend}: {mean}");
+                    println!("{name}, {backend}: mean {mean:.4}");
+                }
+            }
+        },
+    );
+}
+
+#[test]
+fn photons_beyond_the_budget_are_refused_before_they_are_traced() {
+    isolated(
+        "photons_beyond_the_budget_are_refused_before_they_are_traced",
+        || {
+            let scene = Scene::load(common::shipped("glass-block")).unwrap();
+            let vis = Backend::Bvh.build(&scene).unwrap();
+            let options = Options {
+                photons: meshlight::solver::MAX_PHOTONS,
+                memory_budget: 1 << 30,
+                ..quick()
+            };
+            let solved = meshlight::solve(&scene, vis.as_ref(), &options, &mut go);
+            refused("photons", solved, &["photons", "budget"]);
+        },
+    );
+}

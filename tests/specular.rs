@@ -432,18 +432,26 @@ fn a_scene_without_specular_materials_ignores_the_specular_knobs() {
 
 #[test]
 fn specular_scenes_give_the_same_numbers_on_one_thread_and_two() {
-    // Chains, images and camera paths through mirrors, a glossy floor and glass: every random
-    // choice is seeded from the sample or pixel, never from a thread.
-    for name in ["mirror-room", "glossy-room", "glass-room"] {
+    // Chains, images and camera paths through mirrors, a glossy floor and glass, and photons
+    // (through a glass block, and along the chains a cab of mirrors leaves to them): every
+    // random choice is seeded from the sample, pixel or photon, never from a thread.
+    for name in [
+        "mirror-room",
+        "glossy-room",
+        "glass-room",
+        "glass-block",
+        "mirror-cab",
+    ] {
         let scene = shipped_at(name, 24);
         let vis = meshlight::Backend::default_backend().build(&scene).unwrap();
+        // Inside every one of the rooms (the cab is 3 × 2.6 × 3 m).
         let floor = Grid::new(
             "above the boxes",
             Vec3::new(0.5, 2.0, 0.5),
-            Vec3::new(3.0, 0.0, 0.0),
-            Vec3::new(0.0, 0.0, 3.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 2.0),
             Some(Vec3::Y),
-            Some(0.5),
+            Some(0.4),
         )
         .unwrap();
         let run = |threads: usize| {

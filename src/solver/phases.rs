@@ -375,8 +375,15 @@ impl Solve<'_> {
                     threads,
                 );
                 let mut report = self.reporter.part(base);
-                queries +=
-                    transfer.trace_photons(scene, vis, (spec, lights), settings, &mut report)?;
+                let budget = options.memory_budget;
+                queries += transfer.trace_photons(
+                    scene,
+                    vis,
+                    (spec, lights),
+                    settings,
+                    budget,
+                    &mut report,
+                )?;
             }
             let caustic = if transfer.landings.is_empty() || self.reporter.stopped() {
                 let mut kept = transfer.caustic.clone();

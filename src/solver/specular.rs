@@ -108,12 +108,14 @@ impl Transfer {
     }
 
     /// Sends the photons (where the scene needs them) and keeps their landings; the queries.
+    /// Landings that could pass a quarter of `budget` (bytes) are refused before any is traced.
     pub(crate) fn trace_photons(
         &mut self,
         scene: &Scene,
         vis: &dyn Visibility,
         (spec, lights): (&Specular, &Lights),
         (count, depth, seed, threads): (u64, u32, u64, usize),
+        budget: usize,
         report: crate::parallel::Report,
     ) -> Result<u64> {
         let listing = crate::specular::images::chains(spec, depth);
@@ -121,6 +123,18 @@ impl Transfer {
             return Ok(0);
         }
         let pass = photons::Photons::new(scene, (spec, &listing, lights), vis, count, depth);
+        let most = pass.count() as f64 * std::mem::size_of::<Landing>() as f64;
+        if most > budget as f64 / 4.0 {
+            return Err(crate::budget::exceeded(
+                budget,
+                format!(
+                    "{} photons could land in {}, more than a quarter of the budget: send fewer \
+                     photons or raise the budget",
+                    crate::budget::human_count(pass.count() as f64),
+                    crate::budget::human_bytes(most)
+                ),
+            ));
+        }
         let found = pass.trace(seed, threads, report)?;
         self.landings = found.landings;
         Ok(found.queries)

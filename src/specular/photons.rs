@@ -194,6 +194,11 @@ impl<'a> Photons<'a> {
         }
     }
 
+    /// Photons sent in all (each light and object's share, at least a few each).
+    pub(crate) fn count(&self) -> u64 {
+        self.pairs.iter().map(|p| p.photons).sum()
+    }
+
     /// Traces every photon on up to `threads` threads; the landings come in a fixed order
     /// (pair by pair, photon by photon), whatever the threads. A Stop heard in `report` leaves
     /// the photons not traced yet out.
