@@ -59,6 +59,33 @@ struct Emitter {
     bounds: (Vec3, f32),
 }
 
+/// Point `s` of a Fibonacci lattice of `count` in the unit square, shifted by `shift`
+/// (Cranley–Patterson): the first coordinate steps evenly, the second by the golden ratio.
+fn lattice(s: u32, count: u32, shift: (f64, f64)) -> (f64, f64) {
+    let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
+    let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
+    (u1, u2)
+}
+
+/// The point of triangle `[a, b, c]` at (u1, u2) in the unit square, uniform over its area.
+pub(crate) fn in_triangle([a, b, c]: [Vec3; 3], u1: f64, u2: f64) -> Vec3 {
+    let (r1, r2) = (u1.sqrt() as f32, u2 as f32);
+    a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
+}
+
+/// The running sum of the triangles' areas: a triangle is picked by area where it passes a
+/// uniform number × the total (the last entry).
+pub(crate) fn cumulative_area(triangles: &[&crate::scene::Triangle]) -> Vec<f64> {
+    let mut total = 0.0;
+    triangles
+        .iter()
+        .map(|t| {
+            total += f64::from(t.area);
+            total
+        })
+        .collect()
+}
+
 /// The sphere around some triangles: their vertices' mean and the farthest vertex from it.
 fn bounds(triangles: &[[Vec3; 3]]) -> (Vec3, f32) {
     let n = (3 * triangles.len()).max(1) as f32;
@@ -124,21 +151,8 @@ impl DirectLight {
             .emitter_groups()
             .into_iter()
             .map(|group| {
-                let triangles: Vec<&crate::scene::Triangle> = group
-                    .iter()
-                    .flat_map(|&s| {
-                        let range = &scene.surfaces[s as usize].triangles;
-                        &scene.triangles[range.start as usize..range.end as usize]
-                    })
-                    .collect();
-                let mut total = 0.0;
-                let cumulative = triangles
-                    .iter()
-                    .map(|t| {
-                        total += f64::from(t.area);
-                        total
-                    })
-                    .collect();
+                let triangles = scene.triangles_of(&group);
+                let cumulative = cumulative_area(&triangles);
                 let tris: Vec<[Vec3; 3]> = triangles.iter().map(|t| t.vertices).collect();
                 let (first, material) = (group[0], scene.material_of(group[0]));
                 let surface = &scene.surfaces[first as usize];
@@ -555,8 +569,7 @@ impl DirectLight {
         let count = self.light_samples;
         let shift = (rng.random::<f64>(), rng.random::<f64>());
         for s in 0..count {
-            let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
-            let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
+            let (u1, u2) = lattice(s, count, shift);
             // The first coordinate runs along the emitter's cumulative solid angle (or area):
             // it picks the triangle, and what is left of it places the point inside.
             let u = u1 * total;
@@ -572,9 +585,7 @@ impl DirectLight {
                     None => continue,
                 }
             } else {
-                let [a, b, c] = emitter.triangles[t];
-                let (r1, r2) = (within.sqrt() as f32, u2 as f32);
-                a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
+                in_triangle(emitter.triangles[t], within, u2)
             };
             let d = y - x;
             let dist2 = d.length_squared();
@@ -646,8 +657,7 @@ impl DirectLight {
         let count = self.light_samples;
         let shift = (rng.random::<f64>(), rng.random::<f64>());
         for s in 0..count {
-            let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
-            let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
+            let (u1, u2) = lattice(s, count, shift);
             // The first coordinate picks a triangle by its irradiance; what is left of it and
             // the second place the point uniformly inside.
             let u = u1 * irradiance;
@@ -657,8 +667,7 @@ impl DirectLight {
             let (t, e, end) = facing[k];
             let within = ((u - (end - e)) / e).clamp(0.0, 1.0);
             let [a, b, c] = emitter.triangles[t];
-            let (r1, r2) = (within.sqrt() as f32, u2 as f32);
-            let y = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
+            let y = in_triangle([a, b, c], within, u2);
             let normal = emitter.facets[t].0;
             let d = y - x;
             let dist2 = d.length_squared();

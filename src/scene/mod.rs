@@ -749,6 +749,17 @@ impl Scene {
         self.emitter_groups().len()
     }
 
+    /// The triangles of some surfaces, surface by surface.
+    pub(crate) fn triangles_of(&self, surfaces: &[u32]) -> Vec<&Triangle> {
+        surfaces
+            .iter()
+            .flat_map(|&s| {
+                let range = &self.surfaces[s as usize].triangles;
+                &self.triangles[range.start as usize..range.end as usize]
+            })
+            .collect()
+    }
+
     /// The area lights as lights are sampled: lists of emitting surfaces, each a light (see
     /// `adjacency::emitter_groups`).
     pub(crate) fn emitter_groups(&self) -> Vec<Vec<u32>> {

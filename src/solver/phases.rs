@@ -325,83 +325,8 @@ impl Solve<'_> {
         }
         solution.covered.reserve_exact(covered.len());
         solution.covered.extend(covered);
-        if let (Some(transfer), Some((spec, lights))) = (
-            solution.specular.as_mut().map(std::mem::take),
-            &self.specular,
-        ) {
-            // The chains of the new samples, and the lights' light they bring.
-            let mut transfer = transfer;
-            let settings = (
-                options.specular_depth,
-                options.specular_rays,
-                options.seed,
-                threads,
-            );
-            queries += if self.reporter.stopped() {
-                transfer.direct.resize(n, DVec3::ZERO);
-                transfer.specular_share.resize(n, 0.0);
-                0
-            } else {
-                transfer.follow(scene, solution, vis, (spec, lights), settings, first_new)?
-            };
-            // The lights seen through two reflectors or more: taken whole, not interpolated.
-            if let Some(far) = &self.far_light {
-                let base = self.base(Phase::DirectLight, round, n);
-                let at = (points.as_slice(), ids.as_slice());
-                let (part, q) = if self.reporter.stopped() {
-                    (vec![Arrival::default(); points.len()], 0)
-                } else {
-                    let mut report = self.reporter.part(base);
-                    arrive(
-                        far,
-                        vis,
-                        self.ranks,
-                        at,
-                        (options.seed, threads),
-                        &mut report,
-                    )?
-                };
-                queries += q;
-                transfer.far.extend(part.iter().map(|a| a.irradiance));
-            }
-            // Photons: sent once, spread over each round's areas. Old samples take the change
-            // their new areas make; new ones start from theirs (`warm`).
-            if first_new == 0 && !self.reporter.stopped() {
-                let base = self.base(Phase::Photons, round, n);
-                let settings = (
-                    options.photons,
-                    options.specular_depth,
-                    options.seed,
-                    threads,
-                );
-                let mut report = self.reporter.part(base);
-                let budget = options.memory_budget;
-                queries += transfer.trace_photons(
-                    scene,
-                    vis,
-                    (spec, lights),
-                    settings,
-                    budget,
-                    &mut report,
-                )?;
-            }
-            let caustic = if transfer.landings.is_empty() || self.reporter.stopped() {
-                let mut kept = transfer.caustic.clone();
-                kept.resize(n, DVec3::ZERO);
-                kept
-            } else {
-                transfer.deposit(solution)
-            };
-            for (k, new) in caustic.iter().enumerate().take(first_new) {
-                let change = *new - transfer.caustic.get(k).copied().unwrap_or_default();
-                let rho = reflectance(scene, &solution.samples, k);
-                solution.irradiance[k] += change;
-                solution.unshot[k] += rho * change;
-                solution.radiosity[k] += rho * change;
-            }
-            transfer.caustic = caustic;
-            solution.specular = Some(transfer);
-        }
+        let at = (points.as_slice(), ids.as_slice());
+        queries += self.specular_light(solution, round, first_new, at)?;
         warm::start(
             scene,
             solution,
@@ -422,6 +347,101 @@ impl Solve<'_> {
                 .sum();
             solution.ledger.escaped += solution.ledger.emitted - received;
         }
+        Ok(queries)
+    }
+
+    /// The new samples' light by way of specular surfaces that is not interpolated: their
+    /// chains (and the lights' light through glossy bounces), the lights through chains of two
+    /// reflectors or more, and the photons' (sent in the first round, spread over every
+    /// round's areas: old samples take the change their new areas make); the queries.
+    fn specular_light(
+        &mut self,
+        solution: &mut Solution,
+        round: u32,
+        first_new: usize,
+        (points, ids): (&[(Vec3, Vec3)], &[u32]),
+    ) -> Result<u64> {
+        let Some((spec, lights)) = &self.specular else {
+            return Ok(0);
+        };
+        let Some(mut transfer) = solution.specular.as_mut().map(std::mem::take) else {
+            return Ok(0);
+        };
+        let (scene, vis, options) = (self.scene, self.vis, self.options);
+        let threads = options.threads.max(1);
+        let n = solution.samples.len();
+        let mut queries = 0;
+        // The chains of the new samples, and the lights' light they bring.
+        let settings = (
+            options.specular_depth,
+            options.specular_rays,
+            options.seed,
+            threads,
+        );
+        queries += if self.reporter.stopped() {
+            transfer.direct.resize(n, DVec3::ZERO);
+            transfer.specular_share.resize(n, 0.0);
+            0
+        } else {
+            transfer.follow(scene, solution, vis, (spec, lights), settings, first_new)?
+        };
+        // The lights seen through two reflectors or more: taken whole, not interpolated.
+        if let Some(far) = &self.far_light {
+            let base = self.base(Phase::DirectLight, round, n);
+            let at = (points, ids);
+            let (part, q) = if self.reporter.stopped() {
+                (vec![Arrival::default(); points.len()], 0)
+            } else {
+                let mut report = self.reporter.part(base);
+                arrive(
+                    far,
+                    vis,
+                    self.ranks,
+                    at,
+                    (options.seed, threads),
+                    &mut report,
+                )?
+            };
+            queries += q;
+            transfer.far.extend(part.iter().map(|a| a.irradiance));
+        }
+        // Photons: sent once, spread over each round's areas. Old samples take the change
+        // their new areas make; new ones start from theirs (`warm`).
+        if first_new == 0 && !self.reporter.stopped() {
+            let base = self.base(Phase::Photons, round, n);
+            let settings = (
+                options.photons,
+                options.specular_depth,
+                options.seed,
+                threads,
+            );
+            let mut report = self.reporter.part(base);
+            let budget = options.memory_budget;
+            queries += transfer.trace_photons(
+                scene,
+                vis,
+                (spec, lights),
+                settings,
+                budget,
+                &mut report,
+            )?;
+        }
+        let caustic = if transfer.landings.is_empty() || self.reporter.stopped() {
+            let mut kept = transfer.caustic.clone();
+            kept.resize(n, DVec3::ZERO);
+            kept
+        } else {
+            transfer.deposit(solution)
+        };
+        for (k, new) in caustic.iter().enumerate().take(first_new) {
+            let change = *new - transfer.caustic.get(k).copied().unwrap_or_default();
+            let rho = reflectance(scene, &solution.samples, k);
+            solution.irradiance[k] += change;
+            solution.unshot[k] += rho * change;
+            solution.radiosity[k] += rho * change;
+        }
+        transfer.caustic = caustic;
+        solution.specular = Some(transfer);
         Ok(queries)
     }
 

@@ -39,21 +39,9 @@ impl Lights {
         let mut of_surface = vec![None; scene.surfaces.len()];
         let mut areas = Vec::new();
         for group in scene.emitter_groups() {
-            let triangles: Vec<&crate::scene::Triangle> = group
-                .iter()
-                .flat_map(|&s| {
-                    let range = &scene.surfaces[s as usize].triangles;
-                    &scene.triangles[range.start as usize..range.end as usize]
-                })
-                .collect();
-            let mut total = 0.0;
-            let cumulative = triangles
-                .iter()
-                .map(|t| {
-                    total += f64::from(t.area);
-                    total
-                })
-                .collect();
+            let triangles = scene.triangles_of(&group);
+            let cumulative = crate::light::cumulative_area(&triangles);
+            let total = cumulative.last().copied().unwrap_or(0.0);
             for &s in &group {
                 of_surface[s as usize] = Some(areas.len() as u32);
             }
@@ -239,10 +227,8 @@ impl AreaLight {
             .min(self.triangles.len() - 1);
         let start = if t == 0 { 0.0 } else { self.cumulative[t - 1] };
         let within = ((u - start) / (self.cumulative[t] - start)).clamp(0.0, 1.0);
-        let [a, b, c] = self.triangles[t];
-        let (r1, r2) = (within.sqrt() as f32, u2 as f32);
         (
-            a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2),
+            crate::light::in_triangle(self.triangles[t], within, u2),
             self.normals[t],
         )
     }

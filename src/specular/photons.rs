@@ -361,7 +361,9 @@ impl<'a> Photons<'a> {
         let facing = if back { -tri.normal } else { tri.normal };
         let d = dir.as_dvec3();
         let cos = -d.dot(facing.as_dvec3());
-        // The way on: (direction, a reflection?, power factor).
+        // The way on: (direction, a reflection?, power factor). Not `material::branches`: its
+        // weights carry radiance (÷η² into glass, where a path runs against the light), a
+        // photon carries power, and it takes one branch at random, not both.
         let (next, reflected, factor) = match material.kind {
             Kind::Specular { ks, .. } => {
                 if back && !self.scene.surfaces[s].two_sided {
