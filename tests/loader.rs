@@ -94,6 +94,28 @@ fn gallery_is_gallery_scale() {
 }
 
 #[test]
+fn the_atrium_is_made_of_small_curved_facets() {
+    // Artist-made geometry in kind: most of its planar surfaces are facets of columns, arches,
+    // vaults and cloths, and none of its triangles is degenerate or hidden in a solid's face.
+    let path = meshlight_atrium::ensure().expect("generate the atrium");
+    let s = meshlight::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        s.triangles().len() > 20_000,
+        "{} triangles",
+        s.triangles().len()
+    );
+    let small = s.surfaces().iter().filter(|f| f.area < 0.5).count();
+    assert!(
+        small > 10_000 && small * 10 > 9 * s.surfaces().len(),
+        "{small} of {} surfaces under 0.5 m²",
+        s.surfaces().len()
+    );
+    assert_eq!(s.point_lights().len(), 5);
+    assert_eq!(s.bounds().max, glam::Vec3::new(24.0, 11.0, 12.0));
+    assert!(s.warnings().is_empty(), "{:?}", s.warnings());
+}
+
+#[test]
 fn the_designed_gallery_has_its_luminaires_and_grids() {
     let path = meshlight_gallery::ensure().expect("generate the gallery");
     let design = path.with_file_name("design.toml");

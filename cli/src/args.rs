@@ -24,6 +24,10 @@ pub struct Args {
     /// glTF's first).
     #[arg(long, global = true, value_name = "NAME")]
     pub camera: Option<String>,
+    /// No progress lines (by default a bar on a terminal, a plain line every few seconds in a
+    /// log).
+    #[arg(long, global = true)]
+    pub quiet: bool,
 }
 
 /// Solver settings shared by `render` and `samples`.

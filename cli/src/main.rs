@@ -48,6 +48,7 @@ fn main() -> ExitCode {
         }
     }
     let args = Args::parse();
+    progress::set_quiet(args.quiet);
     // MPI is finalised when the job drops, after everything else.
     let _job = ranks::start();
     let loading = LoadOptions {

@@ -1,19 +1,53 @@
 //! The progress line on stderr while the library works: the phase, the share done and the time
 //! it still needs, for every long call through the library's one progress contract.
 
-use std::time::Duration;
+use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use meshlight::progress::{Control, Phase, Progress};
 use meshlight::solver::{EpsilonSource, Options};
 use meshlight::{Scene, Solution, Visibility};
 
+/// Whether `--quiet` silenced the progress lines.
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// Seconds between the plain progress lines written where stderr is not a terminal.
+const PLAIN_EVERY: f64 = 5.0;
+
+/// Silences (or not) every progress line from now on (`--quiet`).
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, Ordering::Relaxed);
+}
+
 /// Runs `call` with a progress line on stderr about `what` ("solve" gives rounds and samples),
-/// cleared when it returns.
+/// cleared when it returns. Where stderr is not a terminal (a log file, a batch job) a bar
+/// would show nothing: a plain line is written instead at the first report and then every
+/// [`PLAIN_EVERY`] seconds. `--quiet` writes neither.
 pub fn with_progress<T>(
     what: &str,
     call: impl FnOnce(&mut dyn FnMut(&Progress) -> Control) -> T,
 ) -> T {
+    if QUIET.load(Ordering::Relaxed) {
+        return call(&mut |p: &Progress| {
+            crate::ranks::injected_failure(p);
+            Control::Continue
+        });
+    }
+    if !std::io::stderr().is_terminal() {
+        let start = Instant::now();
+        let mut next = 0.0;
+        return call(&mut |p: &Progress| {
+            crate::ranks::injected_failure(p);
+            let t = start.elapsed().as_secs_f64();
+            if t >= next {
+                eprintln!("meshlight: {t:>5.0} s: {}", line(what, p));
+                next = t + PLAIN_EVERY;
+            }
+            Control::Continue
+        });
+    }
     let bar = ProgressBar::new_spinner();
     bar.set_style(
         ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}").expect("valid template"),

@@ -927,3 +927,37 @@ fn a_preset_sets_the_render_too_and_given_options_override_it() {
     let (_, out) = shadow_rays(&["--preset", "final", "--supersample", "1"]);
     assert!(out.contains("ε 0.06 (scene file × 0.6)"), "{out}");
 }
+
+#[test]
+fn a_run_whose_stderr_is_a_log_prints_plain_progress_lines_unless_quiet() {
+    // Here stderr is a pipe, as in a batch job's log: a progress bar would hide itself and a
+    // long run say nothing until it ends. Plain lines instead (the first at the first report,
+    // then every few seconds), for the solve and the render; none with --quiet.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a.exr");
+    let args = [
+        "render",
+        "scenes/box/scene.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--rounds",
+        "0",
+    ];
+    let run = succeed(&args);
+    let log = text(&run.stderr);
+    let lines: Vec<&str> = log
+        .lines()
+        .filter(|l| l.starts_with("meshlight: ") && l.contains(" s: "))
+        .collect();
+    assert!(
+        lines.iter().any(|l| l.contains("round 0: "))
+            && lines.iter().any(|l| l.contains("render: ")),
+        "{log}"
+    );
+    let quiet = succeed(&[&args[..], &["--quiet"]].concat());
+    assert!(
+        !text(&quiet.stderr).lines().any(|l| l.contains(" s: round")),
+        "{}",
+        text(&quiet.stderr)
+    );
+}
