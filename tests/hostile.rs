@@ -724,3 +724,143 @@ fn photons_beyond_the_budget_are_refused_before_they_are_traced() {
         },
     );
 }
+
+// --- glTF files: node graphs, and what their lights and cameras bring. ---
+
+/// A glTF of one triangle (mesh 0) with `nodes` (JSON), `roots` in its scene, and extra
+/// top-level JSON members `more` (lights, cameras).
+fn gltf_with(nodes: &str, roots: &str, more: &str) -> Vec<u8> {
+    format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "buffers": [{{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}}],
+  "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+  "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                  "min": [0, 0, 0], "max": [1, 1, 0]}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+  "nodes": {nodes},
+  "scenes": [{{"nodes": {roots}}}],
+  "scene": 0{more}}}"#
+    )
+    .into_bytes()
+}
+
+/// A perspective camera, as `gltf_with`'s `more`.
+const CAMERA: &str =
+    r#", "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]"#;
+
+fn load_gltf(bytes: Vec<u8>) -> meshlight::Result<Scene> {
+    let files = meshlight::scene::Memory::default().with("x.gltf", bytes);
+    Scene::load_from(&files, "x.gltf")
+}
+
+#[test]
+fn gltf_node_cycles_are_refused_by_name_and_deep_instancing_is_bounded() {
+    isolated(
+        "gltf_node_cycles_are_refused_by_name_and_deep_instancing_is_bounded",
+        || {
+            // A node that is its own child; two nodes that are each other's.
+            let own = gltf_with(r#"[{"mesh": 0, "children": [0]}]"#, "[0]", "");
+            refused("own child", load_gltf(own), &["node 0", "cycle"]);
+            let two = gltf_with(r#"[{"children": [1]}, {"children": [0]}]"#, "[0]", "");
+            refused("2-cycle", load_gltf(two), &["cycle"]);
+            // 40 levels, each node the child of the one above twice: 2^40 instances.
+            let nodes: Vec<String> = (0..40)
+                .map(|i| {
+                    if i < 39 {
+                        format!(r#"{{"mesh": 0, "children": [{}, {}]}}"#, i + 1, i + 1)
+                    } else {
+                        r#"{"mesh": 0}"#.to_string()
+                    }
+                })
+                .collect();
+            let doubled = gltf_with(&format!("[{}]", nodes.join(",")), "[0]", "");
+            refused("doubled", load_gltf(doubled), &["nodes", "refused"]);
+            // Instancing within bounds is fine: one triangle in three places.
+            let shared = gltf_with(
+                r#"[{"children": [1, 2, 3]}, {"mesh": 0}, {"mesh": 0, "translation": [2, 0, 0]},
+                   {"mesh": 0, "translation": [4, 0, 0]}, {"camera": 0, "translation": [2, 0, 5]}]"#,
+                "[0, 4]",
+                CAMERA,
+            );
+            // (No light: loading is what is tested.)
+            let scene = load_gltf(shared).unwrap();
+            assert_eq!(scene.triangles().len(), 3);
+        },
+    );
+}
+
+#[test]
+fn a_fifo_named_as_a_buffer_is_refused_not_waited_on() {
+    isolated("a_fifo_named_as_a_buffer_is_refused_not_waited_on", || {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("buffer.bin");
+        let made = Command::new("mkfifo").arg(&fifo).status();
+        if !made.is_ok_and(|s| s.success()) {
+            println!("no mkfifo here: skipped");
+            return;
+        }
+        let gltf = String::from_utf8(gltf_with(r#"[{"mesh": 0}]"#, "[0]", ""))
+            .unwrap()
+            .replace(
+                "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA",
+                "buffer.bin",
+            );
+        let path = dir.path().join("x.gltf");
+        std::fs::write(&path, gltf).unwrap();
+        refused("fifo", Scene::load(&path), &["buffer.bin", "regular file"]);
+    });
+}
+
+#[test]
+fn gltf_lights_and_cameras_get_the_checks_a_hosts_do() {
+    isolated("gltf_lights_and_cameras_get_the_checks_a_hosts_do", || {
+        let light = |intensity: &str, colour: &str| {
+            gltf_with(
+                r#"[{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]},
+                    {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 0, 1]}]"#,
+                "[0, 1, 2]",
+                &format!(
+                    r#"{CAMERA}, "extensionsUsed": ["KHR_lights_punctual"],
+  "extensions": {{"KHR_lights_punctual": {{"lights": [{{"type": "point", "intensity": {intensity}, "color": {colour}}}]}}}}"#
+                ),
+            )
+        };
+        refused(
+            "negative",
+            load_gltf(light("-1e6", "[1, 1, 1]")),
+            &["light 0", "negative"],
+        );
+        refused(
+            "huge",
+            load_gltf(light("1e39", "[1, 1, 1]")),
+            &["light 0", "finite"],
+        );
+        refused(
+            "colour",
+            load_gltf(light("10", "[1, -0.5, 1]")),
+            &["light 0", "negative"],
+        );
+        assert!(load_gltf(light("10", "[1, 0.5, 1]")).is_ok());
+        let camera = |perspective: &str| {
+            gltf_with(
+                r#"[{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}]"#,
+                "[0, 1]",
+                &format!(
+                    r#", "cameras": [{{"type": "perspective", "perspective": {perspective}}}]"#
+                ),
+            )
+        };
+        refused(
+            "fov 0",
+            load_gltf(camera(r#"{"yfov": 0.0, "znear": 0.1}"#)),
+            &["camera", "fov"],
+        );
+        refused(
+            "tall",
+            load_gltf(camera(
+                r#"{"yfov": 1.0, "znear": 0.1, "aspectRatio": 1e-7}"#,
+            )),
+            &["camera", "image size", "too large"],
+        );
+    });
+}

@@ -30,6 +30,12 @@ pub(super) struct GltfScene {
     pub warnings: Vec<String>,
 }
 
+/// Nodes a file's graph may unfold into (each instance of a node counts).
+const MAX_NODE_VISITS: usize = 1_000_000;
+
+/// Triangles a file's meshes may unfold into, instances counted.
+const MAX_TRIANGLES: usize = 50_000_000;
+
 /// Reads `path` (a `.gltf` or `.glb`); `units` decides how lights come across, `max_reflectance`
 /// and `strict` how a white base colour is treated, as for MTL files.
 pub(super) fn read(
@@ -130,9 +136,33 @@ pub(super) fn read(
     else {
         return Err(fail("it has no scene".into()));
     };
-    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    // Depth first, with the path from the root: a node among its own ancestors is a cycle (the
+    // walk would never end). A node reached again by another way is an instance, as many times
+    // as the file says, up to MAX_NODE_VISITS.
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     stack.reverse();
-    while let Some((node, parent)) = stack.pop() {
+    let mut path_from_root: Vec<usize> = Vec::new();
+    let mut visits = 0usize;
+    while let Some((node, parent, depth)) = stack.pop() {
+        path_from_root.truncate(depth);
+        if path_from_root.contains(&node.index()) {
+            return Err(fail(format!(
+                "node {} is its own ancestor (through nodes {:?}): the node graph has a cycle",
+                node.index(),
+                path_from_root
+            )));
+        }
+        path_from_root.push(node.index());
+        visits += 1;
+        if visits > MAX_NODE_VISITS || out.mesh.triangles.len() > MAX_TRIANGLES {
+            return Err(fail(format!(
+                "its nodes, instanced as the file asks, make more than {} nodes or {} \
+                 triangles: refused",
+                crate::budget::human_count(MAX_NODE_VISITS as f64),
+                crate::budget::human_count(MAX_TRIANGLES as f64)
+            )));
+        }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
         if !world.is_finite() {
@@ -269,17 +299,19 @@ pub(super) fn read(
                         .name()
                         .or(camera.name())
                         .map_or_else(|| format!("camera {}", camera.index()), str::to_string);
-                    out.cameras.push((
-                        name,
-                        Camera {
-                            position,
-                            look_at: position + forward,
-                            up,
-                            fov_y: p.yfov().to_degrees(),
-                            width,
-                            height,
-                        },
-                    ));
+                    let camera = Camera {
+                        position,
+                        look_at: position + forward,
+                        up,
+                        fov_y: p.yfov().to_degrees(),
+                        width,
+                        height,
+                    };
+                    // The checks a host's camera gets (`Scene::set_camera`).
+                    if let Some(problem) = camera.problem() {
+                        return Err(fail(format!("camera '{name}': {problem}")));
+                    }
+                    out.cameras.push((name, camera));
                 }
                 gltf::camera::Projection::Orthographic(_) => warn(format!(
                     "camera {} is orthographic: only perspective cameras are read",
@@ -295,12 +327,22 @@ pub(super) fn read(
             } else {
                 candela / EFFICACY
             };
+            // The checks a host's point light gets: finite, not negative.
+            let point = PointLight {
+                position: world.transform_point3(Vec3::ZERO),
+                intensity,
+            };
+            if let Some(problem) = super::validate::point_light(&point) {
+                return Err(fail(format!(
+                    "light {} (intensity {}, colour {:?}): {problem}",
+                    light.index(),
+                    light.intensity(),
+                    light.color()
+                )));
+            }
             match light.kind() {
                 gltf::khr_lights_punctual::Kind::Point => {
-                    out.point_lights.push(PointLight {
-                        position: world.transform_point3(Vec3::ZERO),
-                        intensity,
-                    });
+                    out.point_lights.push(point);
                 }
                 gltf::khr_lights_punctual::Kind::Spot {
                     inner_cone_angle,
@@ -333,7 +375,7 @@ pub(super) fn read(
             }
         }
         for child in node.children().collect::<Vec<_>>().into_iter().rev() {
-            stack.push((child, world));
+            stack.push((child, world, depth + 1));
         }
     }
     if out.mesh.triangles.is_empty() {

@@ -17,6 +17,14 @@ pub struct Disk;
 
 impl Source for Disk {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
+        // A FIFO would block the read until a writer came, a device (/dev/zero) would never
+        // end: only regular files are read.
+        if !std::fs::metadata(path)?.is_file() {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "not a regular file (a directory, a FIFO or a device)",
+            ));
+        }
         std::fs::read(path)
     }
 }
