@@ -123,6 +123,117 @@ pub fn check(mine: usize, counts: &[usize], out: usize, rank: usize) -> Result<(
     Ok(())
 }
 
+/// The most ranks a solve may be spread over: beyond, the bookkeeping that grows with the
+/// ranks (an exchange's lengths are ranks² numbers) would not fit, and no solve gains.
+pub const MAX_RANKS: usize = 4096;
+
+/// A host's transport, checked: its rank and size taken once and held to (a rank that changes
+/// between calls is an error), and every answer of its collectives checked before the solver
+/// uses it — numbers finite, words whole, what this rank gave handed back unchanged — so that a
+/// faulty transport is an error that names it, not a wrong image.
+pub(crate) struct Checked<'a> {
+    inner: &'a dyn Ranks,
+    rank: usize,
+    size: usize,
+}
+
+impl<'a> Checked<'a> {
+    /// The transport, if its rank and size make sense.
+    pub(crate) fn new(inner: &'a dyn Ranks) -> Result<Checked<'a>> {
+        let (rank, size) = (inner.rank(), inner.size());
+        if !(1..=MAX_RANKS).contains(&size) || rank >= size {
+            return Err(Error::argument(
+                "ranks",
+                format!("rank {rank} of {size} ranks: the size must lie in 1..={MAX_RANKS}, the rank below it"),
+            ));
+        }
+        Ok(Checked { inner, rank, size })
+    }
+
+    fn fault(problem: String) -> Error {
+        Error::Worker {
+            problem: format!("the ranks' transport failed its check: {problem}"),
+        }
+    }
+
+    /// Whether the transport still says what it said at first.
+    fn steady(&self) -> Result<()> {
+        let (rank, size) = (self.inner.rank(), self.inner.size());
+        if (rank, size) != (self.rank, self.size) {
+            return Err(Self::fault(format!(
+                "it said rank {} of {}, now rank {rank} of {size}",
+                self.rank, self.size
+            )));
+        }
+        Ok(())
+    }
+
+    /// Where this rank's values start in a gather of `counts`.
+    fn offset(&self, counts: &[usize]) -> usize {
+        counts[..self.rank].iter().sum()
+    }
+}
+
+impl Ranks for Checked<'_> {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+
+    fn size(&self) -> usize {
+        self.size
+    }
+
+    fn all_gather(&self, mine: &[f64], counts: &[usize], out: &mut [f64]) -> Result<()> {
+        self.steady()?;
+        check(mine.len(), counts, out.len(), self.rank)?;
+        self.inner.all_gather(mine, counts, out)?;
+        if let Some(bad) = out.iter().find(|v| !v.is_finite()) {
+            return Err(Self::fault(format!("an all-gather handed back {bad}")));
+        }
+        let at = self.offset(counts);
+        if out[at..at + mine.len()] != *mine {
+            return Err(Self::fault(format!(
+                "an all-gather handed rank {}'s own values back changed",
+                self.rank
+            )));
+        }
+        Ok(())
+    }
+
+    fn all_gather_words(&self, mine: &[u32], counts: &[usize], out: &mut [u32]) -> Result<()> {
+        self.steady()?;
+        check(mine.len(), counts, out.len(), self.rank)?;
+        self.inner.all_gather_words(mine, counts, out)?;
+        let at = self.offset(counts);
+        if out[at..at + mine.len()] != *mine {
+            return Err(Self::fault(format!(
+                "an all-gather of words handed rank {}'s own words back changed",
+                self.rank
+            )));
+        }
+        Ok(())
+    }
+
+    fn exchange(&self, to: &[Vec<u32>]) -> Result<Vec<Vec<u32>>> {
+        self.steady()?;
+        let from = self.inner.exchange(to)?;
+        if from.len() != self.size {
+            return Err(Self::fault(format!(
+                "an exchange among {} ranks gave {} lists",
+                self.size,
+                from.len()
+            )));
+        }
+        if to.get(self.rank) != from.get(self.rank) {
+            return Err(Self::fault(format!(
+                "an exchange handed rank {}'s words to itself changed",
+                self.rank
+            )));
+        }
+        Ok(from)
+    }
+}
+
 /// A rank's place alone, to work out what another rank gives (its collectives are not used).
 pub(crate) struct Fixed {
     pub rank: usize,

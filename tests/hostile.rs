@@ -864,3 +864,119 @@ fn gltf_lights_and_cameras_get_the_checks_a_hosts_do() {
         );
     });
 }
+
+#[test]
+fn textures_refuse_a_reflectance_bound_outside_zero_to_one() {
+    // −1 made every texel's reflectance negative (an image mean of −0.18), 2 let white reflect
+    // all light and more (1.45).
+    isolated(
+        "textures_refuse_a_reflectance_bound_outside_zero_to_one",
+        || {
+            use meshlight::scene::Texture;
+            let png = {
+                let mut bytes = Vec::new();
+                image::RgbImage::from_raw(1, 1, vec![255, 255, 255])
+                    .unwrap()
+                    .write_to(
+                        &mut std::io::Cursor::new(&mut bytes),
+                        image::ImageFormat::Png,
+                    )
+                    .unwrap();
+                bytes
+            };
+            for bound in [-1.0, 2.0] {
+                let made = Texture::from_srgb8("white", 1, 1, 3, &[255, 255, 255], bound);
+                assert!(
+                    made.is_err_and(|e| e.contains("max_reflectance")),
+                    "{bound}"
+                );
+                let decoded = Texture::decode("white.png", &png, bound);
+                assert!(
+                    decoded.is_err_and(|e| e.contains("max_reflectance")),
+                    "{bound}"
+                );
+            }
+            assert!(Texture::decode("white.png", &png, 0.9).is_ok());
+        },
+    );
+}
+
+// --- A host's transport between ranks. ---
+
+/// A transport that says it is rank 0 of `size` and answers every collective with `fill`
+/// (everywhere, its own part too, when `own` is false), its rank flipping after `flip` calls.
+struct Faulty {
+    size: usize,
+    fill: f64,
+    own: bool,
+    flip: Option<usize>,
+    calls: std::sync::atomic::AtomicUsize,
+}
+
+impl Faulty {
+    fn new(size: usize, fill: f64, own: bool, flip: Option<usize>) -> Faulty {
+        Faulty {
+            size,
+            fill,
+            own,
+            flip,
+            calls: std::sync::atomic::AtomicUsize::new(0),
+        }
+    }
+}
+
+impl meshlight::distributed::Ranks for Faulty {
+    fn rank(&self) -> usize {
+        let calls = self
+            .calls
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        usize::from(self.flip.is_some_and(|f| calls >= f))
+    }
+
+    fn size(&self) -> usize {
+        self.size
+    }
+
+    fn all_gather(&self, mine: &[f64], _: &[usize], out: &mut [f64]) -> meshlight::Result<()> {
+        out.fill(self.fill);
+        if self.own {
+            out[..mine.len()].copy_from_slice(mine);
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn a_faulty_transport_is_an_error_that_names_it() {
+    isolated("a_faulty_transport_is_an_error_that_names_it", || {
+        let scene = room();
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let solve = |ranks: &dyn meshlight::distributed::Ranks| {
+            meshlight::solver::solve_distributed(&scene, vis.as_ref(), &quick(), ranks, &mut go)
+        };
+        // Sizes no job has: 2⁴⁰ once allocated that many numbers, usize::MAX overflowed.
+        for size in [1usize << 40, usize::MAX, 0] {
+            refused(
+                "size",
+                solve(&Faulty::new(size, 0.0, true, None)),
+                &["ranks", "size"],
+            );
+        }
+        // NaN, or −1 where this rank's own values should come back, or a rank that changes.
+        refused(
+            "NaN",
+            solve(&Faulty::new(2, f64::NAN, true, None)),
+            &["transport", "NaN"],
+        );
+        refused(
+            "-1",
+            solve(&Faulty::new(2, -1.0, false, None)),
+            &["transport", "own"],
+        );
+        refused(
+            "flip",
+            solve(&Faulty::new(2, 0.0, true, Some(5))),
+            &["transport", "rank 1"],
+        );
+    });
+}

@@ -207,6 +207,8 @@ pub fn render_distributed(
     crate::parallel::guarded("rendering", || {
         let checked = crate::visibility::Checked::new(vis, scene);
         let vis: &dyn crate::visibility::Visibility = &checked;
+        let ranks = crate::distributed::Checked::new(ranks)?;
+        let ranks: &dyn crate::distributed::Ranks = &ranks;
         let camera = &scene.camera;
         camera.check()?;
         solution.check_fits(scene)?;

@@ -113,8 +113,10 @@ pub fn errors(
         threads,
         error,
         report,
-        |&e| [e],
-        |v| v[0],
+        // Across ranks "no neighbour" travels as −1: a transport carries finite numbers
+        // (`distributed::Checked` refuses others).
+        |&e| [if e.is_nan() { -1.0 } else { e }],
+        |v| if v[0] < 0.0 { f64::NAN } else { v[0] },
     )?;
     if !all {
         return Ok(None);

@@ -49,6 +49,9 @@ impl Texture {
         max_reflectance: f32,
     ) -> Result<Texture, String> {
         let name = name.into();
+        if let Some(problem) = super::validate::max_reflectance(max_reflectance) {
+            return Err(problem);
+        }
         check_size(width, height)?;
         if !(3..=4).contains(&channels) {
             return Err(format!(
@@ -93,6 +96,9 @@ impl Texture {
         max_reflectance: f32,
     ) -> Result<Texture, String> {
         let name = name.into();
+        if let Some(problem) = super::validate::max_reflectance(max_reflectance) {
+            return Err(problem);
+        }
         let mut reader = image::ImageReader::new(Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| e.to_string())?;
@@ -287,8 +293,11 @@ mod tests {
                 [v, v, v]
             })
             .collect();
-        Texture::from_srgb8("checker", n, n, 3, &data, 1.0).unwrap()
+        Texture::from_srgb8("checker", n, n, 3, &data, WHITE).unwrap()
     }
+
+    /// What white (255) reads as in `checker`'s textures.
+    const WHITE: f32 = 0.99;
 
     #[test]
     fn srgb_decodes_to_the_standard_values() {
@@ -303,8 +312,8 @@ mod tests {
         let t = checker(2, 255, 0);
         // Texel (0, 0) is white, (1, 0) black: its centre (0.25, 0.25) is white, and halfway
         // between the two centres (0.5, 0.25) is half.
-        assert!((t.at(Vec2::new(0.25, 0.25)).x - 1.0).abs() < 1e-6);
-        assert!((t.at(Vec2::new(0.5, 0.25)).x - 0.5).abs() < 1e-6);
+        assert!((t.at(Vec2::new(0.25, 0.25)).x - WHITE).abs() < 1e-6);
+        assert!((t.at(Vec2::new(0.5, 0.25)).x - WHITE / 2.0).abs() < 1e-6);
         // Repeat: 3.25 is 0.25, -0.75 too.
         assert_eq!(t.at(Vec2::new(3.25, -0.75)), t.at(Vec2::new(0.25, 0.25)));
         // Bound per texel.
@@ -314,10 +323,10 @@ mod tests {
 
     #[test]
     fn a_mean_over_many_checks_is_the_average_of_the_two_colours() {
-        // 64 × 64 checks of white and sRGB 128 (0.21586 linear): any area covering many of
-        // them averages (1 + 0.21586) / 2 = 0.60793, by hand.
+        // 64 × 64 checks of white (0.99: `checker`'s bound) and sRGB 128 (0.21586 linear): any
+        // area covering many of them averages (0.99 + 0.21586) / 2 = 0.60293, by hand.
         let t = checker(64, 255, 128);
-        let expected = (1.0 + srgb_to_linear(128.0 / 255.0)) / 2.0;
+        let expected = (WHITE + srgb_to_linear(128.0 / 255.0)) / 2.0;
         assert!((t.mean().x - expected).abs() < 1e-5);
         for (centre, size) in [(Vec2::new(0.5, 0.5), 0.5), (Vec2::new(0.13, 0.71), 0.3)] {
             let m = t.mean_over(centre, Vec2::new(size, 0.0), Vec2::new(0.0, size));
@@ -325,12 +334,25 @@ mod tests {
         }
         // A small area sees its own texel.
         let one = t.mean_over(Vec2::new(0.5 / 64.0, 0.5 / 64.0), Vec2::ZERO, Vec2::ZERO);
-        assert!((one.x - 1.0).abs() < 1e-6);
+        assert!((one.x - WHITE).abs() < 1e-6);
     }
 
     #[test]
     fn bad_images_are_errors_not_panics() {
         assert!(Texture::decode("x.png", b"not an image", 0.9).is_err());
+        // A bound outside (0, 1) would give negative reflectances, or ones above 1.
+        for bound in [-1.0, 0.0, 1.0, 2.0, f32::NAN] {
+            let made = Texture::from_srgb8("x", 1, 1, 3, &[255, 128, 0], bound);
+            assert!(
+                made.is_err_and(|e| e.contains("max_reflectance")),
+                "{bound}"
+            );
+            let decoded = Texture::decode("x.png", b"not even an image", bound);
+            assert!(
+                decoded.is_err_and(|e| e.contains("max_reflectance")),
+                "{bound}"
+            );
+        }
         assert!(Texture::from_srgb8("x", 0, 4, 3, &[], 0.9).is_err());
         assert!(Texture::from_srgb8("x", 2, 2, 3, &[0; 11], 0.9).is_err());
         assert!(Texture::from_srgb8("x", 99_999, 1, 3, &[0; 3], 0.9)

@@ -334,12 +334,8 @@ pub fn solve_distributed(
     ranks: &dyn crate::distributed::Ranks,
     progress: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<Solution> {
-    if ranks.rank() >= ranks.size() {
-        return Err(Error::argument(
-            "ranks",
-            format!("rank {} of {} ranks", ranks.rank(), ranks.size()),
-        ));
-    }
+    let ranks = crate::distributed::Checked::new(ranks)?;
+    let ranks: &dyn crate::distributed::Ranks = &ranks;
     let method = if options.flat() {
         Method::Flat
     } else {
