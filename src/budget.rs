@@ -103,20 +103,59 @@ pub fn human_number(x: f32) -> String {
 /// hits, the radiance, the edge pixels' lists and their refined values), for the budget.
 pub const BYTES_PER_PIXEL: usize = 96;
 
+/// What this process can hold at most, where the system says: the machine's memory and swap,
+/// and its own address-space limit (`ulimit -v`); `None` where it does not (not Linux).
+fn machine_bytes() -> Option<f64> {
+    let field = |text: &str, key: &str| -> Option<f64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        line.split_whitespace().nth(1)?.parse::<f64>().ok()
+    };
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let memory = field(&meminfo, "MemTotal:")? * 1024.0 + field(&meminfo, "SwapTotal:")? * 1024.0;
+    let address_space = std::fs::read_to_string("/proc/self/limits")
+        .ok()
+        .and_then(|limits| {
+            let line = limits
+                .lines()
+                .find(|l| l.starts_with("Max address space"))?;
+            line.split_whitespace().nth(3)?.parse::<f64>().ok()
+        });
+    Some(address_space.map_or(memory, |a| a.min(memory)))
+}
+
+/// The budget as this process can hold it: a budget raised past the machine (to `usize::MAX`,
+/// say) counts as the machine, so that work too large for it is an error before anything is
+/// allocated, not an abort when the allocation fails.
+pub(crate) fn usable(budget: usize) -> usize {
+    match machine_bytes() {
+        Some(m) if m < budget as f64 => m as usize,
+        _ => budget,
+    }
+}
+
 /// Refuses an image of `width` × `height` pixels, at `per_pixel` bytes each, that the budget
-/// cannot hold, before anything is allocated.
+/// (or the machine) cannot hold, before anything is allocated.
 pub(crate) fn check_image(
     budget: usize,
     (width, height): (u32, u32),
     per_pixel: usize,
 ) -> crate::Result<()> {
     let bytes = f64::from(width) * f64::from(height) * per_pixel as f64;
-    if bytes > budget as f64 {
+    let usable = usable(budget);
+    if bytes > usable as f64 {
+        let what = if usable < budget {
+            format!(
+                "more than this machine holds ({})",
+                human_bytes(usable as f64)
+            )
+        } else {
+            "more than the budget".to_string()
+        };
         return Err(exceeded(
             budget,
             format!(
-                "a {width}×{height} image needs about {} ({per_pixel} bytes a pixel): make the \
-                 camera smaller or raise the budget",
+                "a {width}×{height} image needs about {} ({per_pixel} bytes a pixel), {what}: \
+                 make the camera smaller",
                 human_bytes(bytes)
             ),
         ));

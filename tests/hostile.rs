@@ -980,3 +980,75 @@ fn a_faulty_transport_is_an_error_that_names_it() {
         );
     });
 }
+
+// --- Sizes a host raises past the machine. ---
+
+#[test]
+fn a_budget_raised_past_the_machine_still_refuses_what_cannot_fit() {
+    // At usize::MAX a 32768² render, path trace or patch image once aborted on allocation.
+    isolated(
+        "a_budget_raised_past_the_machine_still_refuses_what_cannot_fit",
+        || {
+            let mut scene = room();
+            let big = meshlight::scene::Camera {
+                width: 32_768,
+                height: 32_768,
+                ..*scene.camera()
+            };
+            scene.set_camera(big).unwrap();
+            let vis = Backend::Bvh.build(&scene).unwrap();
+            let s = meshlight::solve(&scene, vis.as_ref(), &quick(), &mut go).unwrap();
+            let render = RenderOptions {
+                memory_budget: usize::MAX,
+                ..RenderOptions::default()
+            };
+            let r = meshlight::render(&scene, &s, vis.as_ref(), &render, &mut go);
+            refused("render", r.map(|_| ()), &["image", "machine"]);
+            let path = PathOptions {
+                memory_budget: usize::MAX,
+                ..PathOptions::default()
+            };
+            let p = path_trace(&scene, vis.as_ref(), &path, &mut go);
+            refused("path trace", p.map(|_| ()), &["image", "machine"]);
+            let patches = PatchOptions {
+                memory_budget: usize::MAX,
+                ..PatchOptions::default()
+            };
+            let q = patch_radiosity(&scene, vis.as_ref(), &patches, &mut go);
+            refused("patches", q.map(|_| ()), &["image", "machine"]);
+        },
+    );
+}
+
+#[test]
+fn a_path_trace_of_ten_million_samples_takes_passes_sized_by_time() {
+    // spp/32 samples a pass once held 64 × 312,500 paths per worker in flight: an abort. Now
+    // passes last about a quarter of a second, so the time limit and a Stop are heard.
+    isolated(
+        "a_path_trace_of_ten_million_samples_takes_passes_sized_by_time",
+        || {
+            let scene = room();
+            let vis = Backend::Bvh.build(&scene).unwrap();
+            let started = Instant::now();
+            let timed = PathOptions {
+                spp: 10_000_000,
+                seconds: Some(2.0),
+                ..PathOptions::default()
+            };
+            let image = path_trace(&scene, vis.as_ref(), &timed, &mut go).unwrap();
+            assert!(image.spp >= 2 && image.spp < 10_000_000, "{}", image.spp);
+            assert!(started.elapsed().as_secs_f64() < 10.0);
+            let mut reports = 0;
+            let asked = PathOptions {
+                spp: u32::MAX,
+                ..PathOptions::default()
+            };
+            let stopped = path_trace(&scene, vis.as_ref(), &asked, &mut |_| {
+                reports += 1;
+                Control::Stop
+            })
+            .unwrap();
+            assert!(stopped.stopped && stopped.spp == 2, "{} spp", stopped.spp);
+        },
+    );
+}

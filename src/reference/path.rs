@@ -56,6 +56,14 @@ use crate::scene::{Kind, Scene};
 use crate::visibility::{Hit, Ray, Segment, Visibility};
 use mirrors::{Leg, Mirrors, Probe, Step, MAX_CROSSINGS, MAX_MIRROR_DEPTH};
 
+/// Seconds a pass of samples should take: progress, a Stop and the time limit act between
+/// passes.
+const PASS_SECONDS: f64 = 0.25;
+
+/// Samples per pixel a pass takes at most: a pass holds 64 × this many paths in flight per
+/// worker.
+const MAX_PASS: u32 = 256;
+
 /// Path tracing settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathOptions {
@@ -306,8 +314,11 @@ pub fn path_trace(
         let mut sums = vec![[DVec3::ZERO; 2]; pixels];
         let mut rays = std::sync::atomic::AtomicU64::new(0);
         let started = std::time::Instant::now();
-        // Passes of a few samples each: the time limit and progress act between them.
-        let pass = 2u32.max(options.spp / 32).min(options.spp);
+        // Passes of a few samples each: the time limit and progress act between them. Sized
+        // by time (about PASS_SECONDS each, from the last pass's speed), never by the samples
+        // asked for: a pass holds chunk × pass paths in flight, and spp/32 of 10⁷ samples
+        // once asked for 20 M of them.
+        let mut pass = 2u32.min(options.spp);
         let mut done = 0u32;
         let points = scene.point_sources();
         let mut reporter = Reporter::new(progress);
@@ -331,12 +342,16 @@ pub fn path_trace(
                 seed: options.seed,
                 max_bounces: options.max_bounces,
             };
+            let timer = std::time::Instant::now();
             for_chunks(&mut sums, 64, threads, |start, chunk| {
                 let n = tracer.trace(start, chunk, first..first + count)?;
                 rays.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
                 Ok(())
             })?;
             done += count;
+            let per_sample = timer.elapsed().as_secs_f64() / f64::from(count);
+            let fit = (PASS_SECONDS / per_sample.max(1e-9)).clamp(2.0, f64::from(MAX_PASS));
+            pass = (fit as u32) & !1;
             let stop = reporter.report(Progress {
                 fraction: f64::from(done) / f64::from(options.spp),
                 shots: u64::from(done),

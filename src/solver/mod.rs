@@ -381,7 +381,7 @@ fn solve_with(
         });
     }
     let predicted_bytes = predicted * BYTES_PER_SAMPLE as f64;
-    if predicted_bytes > options.memory_budget as f64 / 2.0 {
+    if predicted_bytes > crate::budget::usable(options.memory_budget) as f64 / 2.0 {
         return Err(crate::budget::exceeded(
             options.memory_budget,
             format!(
