@@ -173,6 +173,54 @@ fn a_hundred_thousand_triangles_fanned_around_one_edge_group_in_bounded_time() {
 }
 
 #[test]
+fn a_hundred_thousand_identical_triangles_build_on_every_backend() {
+    isolated(
+        "a_hundred_thousand_identical_triangles_build_on_every_backend",
+        || {
+            // The pure-Rust BVH's builder once took time quadratic in copies of one triangle
+            // (10k copies 48 s); copies are now built once and answer as the first.
+            let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Z];
+            let scene = scene_of(positions, vec![[0, 2, 1]; 100_000]).unwrap();
+            for backend in Backend::available() {
+                let t = Instant::now();
+                let caster = backend.build(&scene).unwrap();
+                println!("{backend}: {:.2} s", t.elapsed().as_secs_f64());
+                // A ray down onto the triangle from y = 1 hits it at t = 1, a ray beside it
+                // misses; and a segment through it is blocked.
+                let down = Vec3::new(0.0, -1.0, 0.0);
+                let rays = [
+                    Ray {
+                        origin: Vec3::new(0.2, 1.0, 0.2),
+                        dir: down,
+                        t_min: 0.0,
+                        t_max: 10.0,
+                    },
+                    Ray {
+                        origin: Vec3::new(0.8, 1.0, 0.8),
+                        dir: down,
+                        t_min: 0.0,
+                        t_max: 10.0,
+                    },
+                ];
+                let mut hits = [None; 2];
+                caster.intersect(&rays, &mut hits).unwrap();
+                let hit = hits[0].unwrap_or_else(|| panic!("{backend}: missed"));
+                assert!((hit.t - 1.0).abs() < 1e-5, "{backend}: t {}", hit.t);
+                assert!((hit.triangle as usize) < 100_000);
+                assert!(hits[1].is_none(), "{backend}: hit beside the triangle");
+                let through = Segment {
+                    a: Vec3::new(0.2, 1.0, 0.2),
+                    b: Vec3::new(0.2, -1.0, 0.2),
+                };
+                let mut blocked = [false];
+                caster.occluded(&[through], &mut blocked).unwrap();
+                assert!(blocked[0], "{backend}: the segment passed through");
+            }
+        },
+    );
+}
+
+#[test]
 fn an_obj_of_a_hundred_thousand_repeated_faces_loads() {
     isolated("an_obj_of_a_hundred_thousand_repeated_faces_loads", || {
         let dir = std::env::temp_dir().join(format!("meshlight-hostile-{}", std::process::id()));
