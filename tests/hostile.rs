@@ -443,6 +443,83 @@ fn hits_on_triangles_the_scene_lacks_are_refused_everywhere() {
     );
 }
 
+/// A backend whose hits are the true ones at a distance no ray can have: −1 or ∞.
+struct FarOff(Box<dyn Visibility>, f32);
+
+impl Visibility for FarOff {
+    fn name(&self) -> &'static str {
+        "far-off"
+    }
+    fn occluded(&self, segments: &[Segment], out: &mut [bool]) -> meshlight::Result<()> {
+        self.0.occluded(segments, out)
+    }
+    fn intersect(&self, rays: &[Ray], out: &mut [Option<Hit>]) -> meshlight::Result<()> {
+        self.0.intersect(rays, out)?;
+        for hit in out.iter_mut().flatten() {
+            hit.t = self.1;
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn hits_at_a_negative_or_infinite_distance_are_the_casters_error() {
+    isolated(
+        "hits_at_a_negative_or_infinite_distance_are_the_casters_error",
+        || {
+            // Once: t = −1 gave a black image without a word, t = ∞ was blamed on the
+            // library's own segments.
+            let scene = room();
+            for backend in Backend::available() {
+                let honest = backend.build(&scene).unwrap();
+                let s = meshlight::solve(&scene, honest.as_ref(), &quick(), &mut go).unwrap();
+                for t in [-1.0, f32::INFINITY] {
+                    let caster = FarOff(backend.build(&scene).unwrap(), t);
+                    let t_is = format!("at t = {t}");
+                    let words = ["far-off", "intersect answered", t_is.as_str()];
+                    let solved = meshlight::solve(&scene, &caster, &quick(), &mut go);
+                    refused("solve", solved.map(|_| ()), &words);
+                    let r =
+                        meshlight::render(&scene, &s, &caster, &RenderOptions::default(), &mut go);
+                    refused("render", r.map(|_| ()), &words);
+                    let paths = PathOptions {
+                        spp: 2,
+                        ..PathOptions::default()
+                    };
+                    let traced = path_trace(&scene, &caster, &paths, &mut go);
+                    refused("path_trace", traced.map(|_| ()), &words);
+                }
+            }
+        },
+    );
+}
+
+#[test]
+fn an_epsilon_beyond_the_scene_is_refused_by_name() {
+    isolated("an_epsilon_beyond_the_scene_is_refused_by_name", || {
+        // Once: "invalid argument segments … 8.5e37", the library blaming its own segment.
+        let scene = room();
+        let diagonal = 12f32.sqrt(); // the 2 × 2 × 2 room
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        for epsilon in [f32::MAX, 1e30, 101.0 * diagonal] {
+            let options = Options {
+                epsilon: Some(epsilon),
+                ..quick()
+            };
+            let solved = meshlight::solve(&scene, vis.as_ref(), &options, &mut go);
+            refused("huge ε", solved.map(|_| ()), &["epsilon", "diagonal"]);
+        }
+        // Within the bound: one sample a side, a lit answer.
+        let options = Options {
+            epsilon: Some(99.0 * diagonal),
+            ..quick()
+        };
+        let s = meshlight::solve(&scene, vis.as_ref(), &options, &mut go).unwrap();
+        assert!(s.samples().len() <= 12, "{} samples", s.samples().len());
+        assert!(s.radiosity().iter().any(|b| b.x > 0.0));
+    });
+}
+
 /// A backend that panics on its first call.
 struct Panicky;
 

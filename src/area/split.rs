@@ -15,7 +15,7 @@ use glam::Vec2;
 use super::{Laid, Layout};
 use crate::distributed::Ranks;
 use crate::error::{Error, Result};
-use crate::parallel::{for_chunks, for_chunks_reporting, Report};
+use crate::parallel::{for_chunks, for_chunks_halting, Report};
 use crate::sampling::shares::{Writer, WHOLE};
 use crate::sampling::{surface_of, Obstruction, Samples, Side, SideIndex, SurfaceMap};
 use crate::visibility::Visibility;
@@ -290,7 +290,7 @@ impl Splitter<'_> {
             .filter(|&r| crate::distributed::deals(ranks, r))
             .collect();
         let mut runs = vec![Run::default(); mine.len()];
-        let count = |i: usize, out: &mut [Run]| {
+        let count = |i: usize, out: &mut [Run], halt: &crate::parallel::Halt| {
             let r = mine[i];
             let run = &mut out[0];
             let mut scratch = Scratch::default();
@@ -304,6 +304,11 @@ impl Splitter<'_> {
             for (cell, id) in cells[ids.clone()].iter().zip(ids) {
                 if !cell.is_new() {
                     continue;
+                }
+                // A run of a slow backend takes seconds: a Stop leaves it to the fallback.
+                if halt.asked() {
+                    *run = Run::default();
+                    return Ok(());
                 }
                 let side = layout.side_of(id);
                 if self.of_cell(side, cell, &mut answers, &mut scratch)? {
@@ -322,7 +327,7 @@ impl Splitter<'_> {
             run.done = true;
             Ok(())
         };
-        if !for_chunks_reporting(&mut runs, 1, threads, count, report)? {
+        if !for_chunks_halting(&mut runs, 1, threads, count, report)? {
             for (i, run) in runs.iter_mut().enumerate().filter(|(_, run)| !run.done) {
                 let r = mine[i];
                 let nearest = (r * RUN..((r + 1) * RUN).min(cells.len()))

@@ -284,7 +284,7 @@ pub fn render_distributed(
             &mut centre,
             w,
             options.threads,
-            trace,
+            |first, out, _: &_| trace(first, out),
             &mut |f| {
                 control(reporter.report(Progress {
                     fraction: CENTRE_SHARE * f,
@@ -324,7 +324,7 @@ pub fn render_distributed(
             &mut refined,
             16,
             options.threads,
-            refine,
+            |first, out, _: &_| refine(first, out),
             &mut |f| {
                 control(reporter.report(Progress {
                     fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,

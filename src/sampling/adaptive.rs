@@ -84,9 +84,13 @@ pub fn errors(
     let n = samples.len();
     let mean = radiosity.iter().map(|&b| luminance(b)).sum::<f64>() / n.max(1) as f64;
     let mut out = vec![0.0; n];
-    let error = |first: usize, chunk: &mut [f64]| {
+    let error = |first: usize, chunk: &mut [f64], halt: &crate::parallel::Halt| {
         let mut near = Vec::new();
         for (e, k) in chunk.iter_mut().zip(first..) {
+            // A slow backend's chunk takes seconds; after a Stop the errors are not read.
+            if halt.asked() {
+                return Ok(());
+            }
             let (side, uv, d) = (samples.side[k], samples.uv[k], samples.radius[k]);
             index.within(samples, side, uv, 2.0 * d, &mut near);
             obstruction.retain_visible(vis, maps, samples, side, samples.position[k], &mut near)?;

@@ -268,6 +268,9 @@ impl Solution {
     }
 }
 
+/// The largest ε a solve takes, in diagonals of the scene's bounds.
+pub const MAX_EPSILON_DIAGONALS: f32 = 100.0;
+
 /// The ε a solve will use, and where it came from.
 pub fn choose_epsilon(scene: &Scene, options: &Options) -> Result<(f32, EpsilonSource)> {
     let (epsilon, source) = match (options.epsilon, scene.solver.epsilon) {
@@ -292,6 +295,20 @@ pub fn choose_epsilon(scene: &Scene, options: &Options) -> Result<(f32, EpsilonS
         return Err(Error::Option {
             option: "epsilon",
             problem: format!("{epsilon} is not a positive length"),
+        });
+    }
+    // Lengths the solve derives from ε (search radii, cover segments, cells) must stay
+    // within the scene's scale; beyond its diagonal every side has one sample anyway.
+    let diagonal = scene.bounds.diagonal();
+    if epsilon > MAX_EPSILON_DIAGONALS * diagonal {
+        return Err(Error::Option {
+            option: "epsilon",
+            problem: format!(
+                "{} is more than {MAX_EPSILON_DIAGONALS} times the scene's diagonal ({}): every \
+                 side would hold one sample long before that; choose a smaller ε",
+                human_number(epsilon),
+                human_number(diagonal)
+            ),
         });
     }
     Ok((epsilon, source))
@@ -470,7 +487,16 @@ fn solve_with(
         }
         match solve.add_samples(&mut solution, round + 1)? {
             Some(more) if more.added > 0 => added = more,
-            _ => break,
+            _ => {
+                // A Stop heard while the errors were measured ends the solve here: the
+                // last round converged, but the solve as a whole was stopped.
+                if solve.reporter.stopped() {
+                    if let Some(last) = solution.rounds.last_mut() {
+                        last.shooting.stop = StopReason::Stopped;
+                    }
+                }
+                break;
+            }
         }
     }
     Ok(solution)

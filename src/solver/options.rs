@@ -9,7 +9,9 @@ pub struct Options {
     /// ε, the Poisson-disk spacing of the initial samples (scene units). `None`: the scene
     /// file's `[solver] epsilon`, else chosen from the reflecting area so that about
     /// [`AUTO_SAMPLES`] initial samples result. Halving ε quadruples the samples and multiplies
-    /// the flat solver's time by about 16.
+    /// the flat solver's time by about 16. At most
+    /// [`MAX_EPSILON_DIAGONALS`](crate::solver::MAX_EPSILON_DIAGONALS) times the scene's
+    /// diagonal (an error beyond).
     pub epsilon: Option<f32>,
     /// Multiplies the ε taken from the scene file or chosen automatically (not one set in
     /// [`Options::epsilon`]), 1/16 to 16: presets use it to trade samples for time whatever

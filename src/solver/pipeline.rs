@@ -19,21 +19,19 @@ use crate::error::{Error, Result};
 /// A pool of workers running `work` on jobs of type `I`, giving results of type `O`.
 pub(crate) struct Pool<'a, I, O> {
     capacity: usize,
-    mode: Mode<'a, I, O>,
+    /// Jobs to the workers.
+    jobs: Sender<(usize, I)>,
+    /// Results back, with their job's index.
+    done: Receiver<(usize, Result<O>)>,
+    _work: std::marker::PhantomData<&'a ()>,
 }
 
-enum Mode<'a, I, O> {
-    /// No worker threads: jobs run on the coordinator, in order.
-    Inline(&'a (dyn Fn(I) -> Result<O> + Sync)),
-    /// Worker threads fed over bounded channels.
-    Workers {
-        jobs: Sender<(usize, I)>,
-        done: Receiver<(usize, Result<O>)>,
-    },
-}
+/// How long the coordinator waits for a result before it ticks (see [`Pool::run_ticking`]).
+pub(crate) const TICK_SECONDS: f64 = 0.2;
+const TICK: std::time::Duration = std::time::Duration::from_millis((TICK_SECONDS * 1000.0) as u64);
 
-/// Runs `body` with a pool of `threads` workers (none when `threads` ≤ 1) that apply `work` to
-/// the jobs `body` hands it, with at most `capacity` jobs in flight.
+/// Runs `body` with a pool of `threads` workers (at least one: the coordinator stays free to
+/// tick) that apply `work` to the jobs `body` hands it, with at most `capacity` jobs in flight.
 pub(crate) fn with_pool<I: Send, O: Send, R>(
     threads: usize,
     capacity: usize,
@@ -41,14 +39,8 @@ pub(crate) fn with_pool<I: Send, O: Send, R>(
     body: impl FnOnce(&mut Pool<'_, I, O>) -> Result<R>,
 ) -> Result<R> {
     let capacity = capacity.max(1);
-    if threads <= 1 {
-        return body(&mut Pool {
-            capacity,
-            mode: Mode::Inline(work),
-        });
-    }
     std::thread::scope(|scope| {
-        let mut pool = Pool::spawn(scope, threads, capacity, work);
+        let mut pool = Pool::spawn(scope, threads.max(1), capacity, work);
         let result = body(&mut pool);
         // Closing the job channel ends the workers once they finish what they hold.
         drop(pool);
@@ -80,7 +72,9 @@ impl<'a, I: Send, O: Send> Pool<'a, I, O> {
         }
         Pool {
             capacity,
-            mode: Mode::Workers { jobs, done },
+            jobs,
+            done,
+            _work: std::marker::PhantomData,
         }
     }
 
@@ -90,19 +84,22 @@ impl<'a, I: Send, O: Send> Pool<'a, I, O> {
     pub fn run(
         &mut self,
         jobs: impl IntoIterator<Item = I>,
-        mut apply: impl FnMut(usize, O) -> Result<ControlFlow<()>>,
+        apply: impl FnMut(usize, O) -> Result<ControlFlow<()>>,
     ) -> Result<ControlFlow<()>> {
-        let (sender, receiver) = match &self.mode {
-            Mode::Inline(work) => {
-                for (index, job) in jobs.into_iter().enumerate() {
-                    if apply(index, run(*work, job)?)?.is_break() {
-                        return Ok(ControlFlow::Break(()));
-                    }
-                }
-                return Ok(ControlFlow::Continue(()));
-            }
-            Mode::Workers { jobs, done } => (jobs, done),
-        };
+        self.run_ticking(jobs, apply, || ControlFlow::Continue(()))
+    }
+
+    /// [`Pool::run`] that also calls `tick` on the coordinator whenever [`TICK_SECONDS`] pass
+    /// without a result (a job of a slow backend can take seconds): its `Break` stops the run
+    /// as `apply`'s does. Jobs that should give up part-way on a stop must be told so by the
+    /// caller (a flag `tick` sets and `work` reads).
+    pub fn run_ticking(
+        &mut self,
+        jobs: impl IntoIterator<Item = I>,
+        mut apply: impl FnMut(usize, O) -> Result<ControlFlow<()>>,
+        mut tick: impl FnMut() -> ControlFlow<()>,
+    ) -> Result<ControlFlow<()>> {
+        let (sender, receiver) = (&self.jobs, &self.done);
         let mut jobs = jobs.into_iter();
         let (mut sent, mut in_flight, mut next) = (0usize, 0usize, 0usize);
         // Results that came back before those ahead of them: slot k holds job next + k.
@@ -121,9 +118,18 @@ impl<'a, I: Send, O: Send> Pool<'a, I, O> {
             if in_flight == 0 {
                 break;
             }
-            let (index, result) = receiver
-                .recv()
-                .map_err(|_| worker_error("the workers are gone"))?;
+            let (index, result) = match receiver.recv_timeout(TICK) {
+                Ok(got) => got,
+                Err(crossbeam_channel::RecvTimeoutError::Timeout) => {
+                    if failure.is_none() && !stopped {
+                        stopped = tick().is_break();
+                    }
+                    continue;
+                }
+                Err(crossbeam_channel::RecvTimeoutError::Disconnected) => {
+                    return Err(worker_error("the workers are gone"))
+                }
+            };
             in_flight -= 1;
             if failure.is_some() || stopped {
                 // Draining what is in flight, so no worker is left waiting.

@@ -115,7 +115,7 @@ pub(crate) fn start(
         &mut out,
         256,
         threads,
-        each,
+        |first, out, _: &_| each(first, out),
         &mut |_| crate::progress::Control::Continue,
         |(h, u, b)| [h.x, h.y, h.z, u.x, u.y, u.z, b.x, b.y, b.z],
         |v| {

@@ -42,15 +42,21 @@ impl Visibility for Checked<'_> {
 
     fn intersect(&self, rays: &[Ray], out: &mut [Option<Hit>]) -> Result<()> {
         self.call("intersect", || self.inner.intersect(rays, out))?;
-        for (i, hit) in out.iter().enumerate() {
+        for (i, (hit, ray)) in out.iter().zip(rays).enumerate() {
             if let Some(h) = hit {
-                if h.triangle as usize >= self.triangles || h.t.is_nan() {
+                // A hit must lie on the ray between its ends: t < 0 or ∞ (or past the far
+                // end by more than rounding) is the backend's error, not the scene's.
+                let beyond = h.t > ray.t_max + 1e-4 * ray.t_max.abs().max(1.0);
+                if h.triangle as usize >= self.triangles || !h.t.is_finite() || h.t < 0.0 || beyond
+                {
                     return Err(Error::Backend {
                         backend: self.inner.name(),
                         problem: format!(
-                            "intersect answered ray {i} of {} with a hit on triangle {} at t = \
-                             {}; the scene has {} triangles",
+                            "intersect answered ray {i} of {} (t from {} to {}) with a hit on \
+                             triangle {} at t = {}; the scene has {} triangles",
                             rays.len(),
+                            ray.t_min,
+                            ray.t_max,
                             h.triangle,
                             h.t,
                             self.triangles

@@ -109,6 +109,8 @@ pub(crate) struct Linker<'a> {
     /// visible fraction instead of being refined (see [`NEGLIGIBLE`]).
     pub faint_links: bool,
     pub seed: u64,
+    /// Set when the host has asked to stop: a pair's search gives up (its links are dropped).
+    pub halt: &'a std::sync::atomic::AtomicBool,
 }
 
 /// Directions of a pair still wanted: light into b (from a), into a (from b).
@@ -174,6 +176,9 @@ impl Linker<'_> {
         let mut probes: Vec<Probe> = Vec::new();
         let mut blocked: Vec<bool> = Vec::new();
         while !stack.is_empty() {
+            if self.halt.load(std::sync::atomic::Ordering::Relaxed) {
+                break;
+            }
             pending.clear();
             segments.clear();
             probes.clear();

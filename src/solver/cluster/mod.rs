@@ -120,6 +120,7 @@ pub(crate) fn shoot(
         tolerance: settings.threshold * reference,
         faint_links: !settings.exact_visibility,
         seed: settings.seed,
+        halt: &std::sync::atomic::AtomicBool::new(false),
     };
     let (groups, flow) = link_groups(&linker, &roots, settings, &mut stats, report)?;
     // Each rank gives 3 values a sample of its groups to every sweep's exchange.
@@ -218,8 +219,18 @@ fn link_groups(
     let mut parts: Vec<Vec<(u32, Links)>> = vec![Vec::new(); roots.len()];
     // The pipeline holds at most its capacity of jobs' links beyond those counted.
     let mut held = 0usize;
+    let done = std::cell::Cell::new(0.0);
+    let halt = |flow: ControlFlow<()>| {
+        if flow.is_break() {
+            linker
+                .halt
+                .store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        flow
+    };
+    let report = std::cell::RefCell::new(report);
     let flow = with_pool(threads, settings.capacity, &link, |pool| {
-        pool.run(jobs.iter().copied(), |i, (first, second)| {
+        let apply = |i: usize, (first, second): (Links, Links)| {
             let job = jobs[i];
             let (x, y) = pairs[job];
             stats.queries += first.queries + second.queries;
@@ -241,10 +252,13 @@ fn link_groups(
                     parts[group].push((job as u32, links));
                 }
             }
-            Ok(flow(report(Tick::linking(
-                (i + 1) as f64 / total.max(1) as f64,
-            ))))
-        })
+            done.set((i + 1) as f64 / total.max(1) as f64);
+            let mut report = report.borrow_mut();
+            Ok(halt(flow(report(Tick::linking(done.get())))))
+        };
+        // A slow backend's pair can take seconds: the host still hears the phase meanwhile.
+        let tick = || halt(flow((report.borrow_mut())(Tick::linking(done.get()))));
+        pool.run_ticking(jobs.iter().copied(), apply, tick)
     })?;
     let owner = if size > 1 {
         let owner = share_groups(ranks, &parts)?;
