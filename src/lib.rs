@@ -47,6 +47,7 @@
 
 mod area;
 pub mod budget;
+pub mod daylight;
 pub mod diagnose;
 pub mod distributed;
 pub mod error;

@@ -1,0 +1,10 @@
+//! Daylight (scene-format v4): where the sun is ([`spa`], NREL's Solar Position Algorithm) and
+//! how bright each part of the sky is ([`sky`]: CIE overcast, uniform, the 15 ISO 15469 general
+//! skies, Perez all-weather).
+
+pub mod sky;
+pub mod spa;
+mod spa_tables;
+
+pub use sky::{Sky, SkyModel};
+pub use spa::{sun_position, LocalTime, Observer, SunPosition};
