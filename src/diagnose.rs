@@ -83,7 +83,10 @@ pub fn before_solve(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>>
     let checked = crate::visibility::Checked::new(vis, scene);
     let vis: &dyn Visibility = &checked;
     let mut found = Vec::new();
-    if scene.emitted_power().max_element() <= 0.0 {
+    let daylight = scene
+        .daylight()
+        .is_some_and(|d| d.diffuse_horizontal() > 0.0 || d.ground_luminance() > 0.0);
+    if scene.emitted_power().max_element() <= 0.0 && !daylight {
         found.push(Finding {
             fatal: true,
             message: "nothing in the scene emits light: no material has a non-zero Ke, and \

@@ -21,6 +21,9 @@ use crate::specular::lights::Lights;
 use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
 
+/// Rays per grid point towards the sky and the ground, where daylight enters a scene.
+const GRID_SKY_RAYS: u32 = 1024;
+
 /// How grid points are measured.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LuxOptions {
@@ -107,12 +110,36 @@ pub fn illuminance(
             DirectLight::with_specular(scene, options.light_samples, solution.specular_depth);
         let at: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, n)).collect();
         let ids: Vec<u32> = (0..points.len() as u32).collect();
-        let (direct, _) = if reporter.report(base) {
+        let (mut direct, _) = if reporter.report(base) {
             (vec![Arrival::default(); points.len()], 0)
         } else {
             let part = &mut reporter.part(base);
             light.at(vis, &at, &ids, options.seed, options.threads, part)?
         };
+        // Daylight entering, with more rays than a sample's: a grid has few points.
+        if let Some(entering) = crate::daylight::entering::Entering::of(scene, GRID_SKY_RAYS) {
+            let mut daylight = vec![DVec3::ZERO; points.len()];
+            if !reporter.stopped() {
+                let work = |first: usize, chunk: &mut [DVec3]| {
+                    let range = first..first + chunk.len();
+                    let (got, _) =
+                        entering.at(vis, &at[range.clone()], &ids[range], options.seed)?;
+                    chunk.copy_from_slice(&got);
+                    Ok(())
+                };
+                let part = &mut reporter.part(base);
+                crate::parallel::for_chunks_reporting(
+                    &mut daylight,
+                    8,
+                    options.threads,
+                    work,
+                    part,
+                )?;
+            }
+            for (d, e) in direct.iter_mut().zip(daylight) {
+                d.irradiance += e;
+            }
+        }
         // Inter-reflected light from every sample.
         let s = &solution.samples;
         let reflected: Vec<DVec3> = (0..s.len())

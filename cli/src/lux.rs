@@ -183,6 +183,9 @@ pub fn measure(
         if let Some(verdict) = &verdict {
             println!("grid '{}': {verdict}", grid.name());
         }
+        for said in daylight_factor(scene, grid, &open) {
+            println!("grid '{}': {said}", grid.name());
+        }
         println!("wrote {} and {}", csv.display(), png.display());
         measured.push(Measured {
             name: grid.name().to_string(),
@@ -197,6 +200,68 @@ pub fn measure(
         });
     }
     Ok(measured)
+}
+
+/// The daylight factor DF = E / E_h of a grid under an overcast or uniform sky (min, average,
+/// median, %), its targets, and a warning where no daylight reaches it.
+fn daylight_factor(scene: &Scene, grid: &meshlight::scene::Grid, values: &[f64]) -> Vec<String> {
+    use meshlight::daylight::SkyModel;
+    let Some(daylight) = scene.daylight() else {
+        return Vec::new();
+    };
+    let mut said = Vec::new();
+    let eh = daylight.diffuse_horizontal();
+    if values.is_empty() || eh <= 0.0 {
+        return said;
+    }
+    if values.iter().all(|&v| v <= 0.0) && scene.emitted_power().max_element() <= 0.0 {
+        said.push(
+            "no daylight reaches it: its points see no sky, through no opening and no glass (is \
+             the model closed, its glass modelled facing inward, or [site] north or up pointing \
+             elsewhere?)"
+                .to_string(),
+        );
+    }
+    if !matches!(
+        daylight.sky().model(),
+        SkyModel::CieOvercast | SkyModel::Uniform
+    ) {
+        return said;
+    }
+    let df: Vec<f64> = values.iter().map(|v| 100.0 * v / eh).collect();
+    let mut sorted = df.clone();
+    sorted.sort_unstable_by(f64::total_cmp);
+    let m = sorted.len();
+    let median = if m % 2 == 1 {
+        sorted[m / 2]
+    } else {
+        0.5 * (sorted[m / 2 - 1] + sorted[m / 2])
+    };
+    let average = df.iter().sum::<f64>() / m as f64;
+    said.push(format!(
+        "daylight factor min {:.2}%, average {:.2}%, median {:.2}% (E_h {} lx){}",
+        sorted[0],
+        average,
+        median,
+        round_label(eh),
+        if scene.emitted_power().max_element() > 0.0 {
+            "; the scene's lamps are counted too"
+        } else {
+            ""
+        }
+    ));
+    for (name, target, value) in [
+        ("average", grid.target_df(), average),
+        ("median", grid.target_df_median(), median),
+    ] {
+        if let Some(t) = target {
+            let verdict = if value >= t { "met" } else { "NOT met" };
+            said.push(format!(
+                "DF {name} {value:.2}% against target {t}%: {verdict}"
+            ));
+        }
+    }
+    said
 }
 
 /// The point lights and luminaires over a grid, in its coordinates (point (i, j) at (i, j)):

@@ -170,6 +170,31 @@ pub fn info(scene: &Scene) -> String {
             if sp.photons { "yes" } else { "no" }
         );
     }
+    if let Some(d) = scene.daylight() {
+        let model = match d.sky().model() {
+            meshlight::daylight::SkyModel::Uniform => "uniform".to_string(),
+            meshlight::daylight::SkyModel::CieOvercast => "CIE overcast".to_string(),
+            meshlight::daylight::SkyModel::Cie(t) => format!("CIE general sky type {t}"),
+            meshlight::daylight::SkyModel::Perez {
+                clearness,
+                brightness,
+            } => format!("Perez (clearness {clearness:.3}, brightness {brightness:.3})"),
+        };
+        let _ = writeln!(
+            s,
+            "sky           {model}, {} lx on the unobstructed horizontal; ground luminance {:.0}",
+            d.diffuse_horizontal(),
+            d.ground_luminance()
+        );
+        if let Some((zenith, azimuth)) = d.sun() {
+            let _ = writeln!(
+                s,
+                "sun:          altitude {:.2}°, azimuth {:.2}° (clockwise from north)",
+                90.0 - zenith,
+                azimuth
+            );
+        }
+    }
     match scene.solver_defaults().epsilon {
         Some(e) => {
             let _ = writeln!(s, "solver        epsilon {e} (scene file)");

@@ -2,9 +2,12 @@
 //! how bright each part of the sky is ([`sky`]: CIE overcast, uniform, the 15 ISO 15469 general
 //! skies, Perez all-weather).
 
+pub(crate) mod entering;
+mod site;
 pub mod sky;
 pub mod spa;
 mod spa_tables;
 
+pub use site::Daylight;
 pub use sky::{Sky, SkyModel};
 pub use spa::{sun_position, LocalTime, Observer, SunPosition};

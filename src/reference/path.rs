@@ -539,7 +539,14 @@ impl Tracer<'_> {
     /// and probes), and the next bounce. Returns whether the path goes on.
     fn shade(&self, index: usize, path: &mut Path, hit: Option<Hit>, queue: &mut Queue) -> bool {
         let scene = self.scene;
-        let Some(hit) = hit else { return false };
+        let Some(hit) = hit else {
+            // Out of the model: the sky or the ground, found by the path's own bounce (no
+            // light sampling of the sky, so no weighing).
+            if let Some(daylight) = scene.daylight() {
+                path.radiance += path.throughput * daylight.radiance(path.ray.dir);
+            }
+            return false;
+        };
         let triangle = &scene.triangles[hit.triangle as usize];
         let surface = &scene.surfaces[triangle.surface as usize];
         let material = &scene.materials[surface.material as usize];

@@ -712,9 +712,14 @@ impl<'a> Shader<'a> {
         let mut pending = Vec::with_capacity(rays.len());
         for (ray, hit) in rays.iter().zip(&hits) {
             let Some(Hit { t, triangle }) = *hit else {
+                // Out of the model: the sky or the ground (black without daylight).
+                let outside = self
+                    .scene
+                    .daylight()
+                    .map_or(0.0, |d| d.radiance(ray.dir) as f32);
                 pending.push(Pending {
                     side: u32::MAX,
-                    fixed: Some(Vec3::ZERO),
+                    fixed: Some(Vec3::splat(outside)),
                     point: Vec3::ZERO,
                     normal: Vec3::ZERO,
                     traced: true,

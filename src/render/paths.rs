@@ -104,7 +104,15 @@ impl Shader<'_> {
             queries += level_rays.len() as u64;
             let mut next = Vec::new();
             for (b, hit) in level.iter().zip(&hits) {
-                let Some(hit) = hit else { continue };
+                let Some(hit) = hit else {
+                    // Out of the model (through a pane, by a mirror): the sky or the ground.
+                    if let Some(d) = self.scene.daylight() {
+                        if self.quantity == Quantity::Radiance {
+                            radiance[b.origin] += b.weight * d.radiance(b.ray.dir);
+                        }
+                    }
+                    continue;
+                };
                 let tri = &self.scene.triangles[hit.triangle as usize];
                 let dir = b.ray.dir.normalize();
                 let back = dir.dot(tri.normal) > 0.0;

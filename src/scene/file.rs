@@ -10,6 +10,8 @@ use toml::Spanned;
 
 use super::overrides::Override;
 use super::{luminance, validate, Camera, Grid, Luminaire, PointLight, SolverDefaults, Units};
+use crate::daylight::spa::{sun_position, LocalTime, Observer};
+use crate::daylight::{Daylight, Sky, SkyModel};
 use crate::error::{Error, Result};
 use crate::ies::Photometry;
 
@@ -32,6 +34,32 @@ struct SceneToml {
     solver: Option<Spanned<SolverToml>>,
     #[serde(default)]
     material: std::collections::BTreeMap<String, Spanned<MaterialToml>>,
+    site: Option<Spanned<SiteToml>>,
+    sky: Option<Spanned<SkyToml>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SiteToml {
+    latitude: Option<f64>,
+    longitude: Option<f64>,
+    timezone: Option<f64>,
+    north: Option<[f32; 3]>,
+    up: Option<[f32; 3]>,
+    ground_reflectance: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkyToml {
+    model: String,
+    #[serde(rename = "type")]
+    kind: Option<u8>,
+    time: Option<String>,
+    diffuse_horizontal: Option<f64>,
+    direct_normal: Option<f64>,
+    sun_altitude: Option<f64>,
+    sun_azimuth: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -88,6 +116,8 @@ struct GridToml {
     spacing: Option<f32>,
     target_em: Option<f64>,
     target_u0: Option<f64>,
+    target_df: Option<f64>,
+    target_df_median: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -132,6 +162,8 @@ pub(super) struct SceneFile {
     pub obj_line: usize,
     /// Comment lines of the scene file that name the OBJ file (how to make it, say).
     pub obj_notes: Vec<String>,
+    /// `[site]` and `[sky]`: the daylight outside.
+    pub daylight: Option<crate::daylight::Daylight>,
 }
 
 impl SceneFile {
@@ -147,6 +179,7 @@ impl SceneFile {
             grids: Vec::new(),
             solver: SolverDefaults::default(),
             overrides: Vec::new(),
+            daylight: None,
             obj_line: 1,
             obj_notes: Vec::new(),
         }
@@ -228,6 +261,7 @@ fn grid(g: GridToml, fail: &dyn Fn(String) -> Error) -> Result<Grid> {
         g.spacing,
     )
     .and_then(|grid| grid.with_targets(g.target_em, g.target_u0))
+    .and_then(|grid| grid.with_df_targets(g.target_df, g.target_df_median))
     .map_err(|problem| fail(format!("grid '{name}': {problem}")))
 }
 
@@ -335,6 +369,8 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         solver.max_reflectance = s.max_reflectance;
     }
 
+    let daylight = daylight(parsed.site, parsed.sky, &at)?;
+
     let line = |span: Range<usize>| line_of(text, span.start);
     let rgb = |v: Spanned<[f32; 3]>| (Vec3::from(*v.get_ref()), line(v.span()));
     let overrides = parsed
@@ -417,7 +453,266 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         overrides,
         obj_line: line_of(text, obj_span.start),
         obj_notes,
+        daylight,
     })
+}
+
+/// `"YYYY-MM-DDTHH:MM"` (or with `:SS`) as a local standard time in `timezone`.
+fn local_time(text: &str, timezone: f64) -> std::result::Result<LocalTime, String> {
+    let bad = || format!("time = \"{text}\" is not YYYY-MM-DDTHH:MM (local standard time)");
+    let (date, clock) = text.trim().split_once(['T', ' ']).ok_or_else(bad)?;
+    let d: Vec<&str> = date.split('-').collect();
+    let c: Vec<&str> = clock.split(':').collect();
+    if d.len() != 3 || !(2..=3).contains(&c.len()) {
+        return Err(bad());
+    }
+    let num = |s: &str| s.parse::<u32>().map_err(|_| bad());
+    let (year, month, day) = (
+        d[0].parse::<i32>().map_err(|_| bad())?,
+        num(d[1])?,
+        num(d[2])?,
+    );
+    let (hour, minute) = (num(c[0])?, num(c[1])?);
+    let second = match c.get(2) {
+        Some(s) => s.parse::<f64>().map_err(|_| bad())?,
+        None => 0.0,
+    };
+    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    let days = [
+        31,
+        if leap { 29 } else { 28 },
+        31,
+        30,
+        31,
+        30,
+        31,
+        31,
+        30,
+        31,
+        30,
+        31,
+    ];
+    let valid = (1..=12).contains(&month)
+        && day >= 1
+        && day <= days[(month.clamp(1, 12) - 1) as usize]
+        && hour < 24
+        && minute < 60
+        && (0.0..60.0).contains(&second)
+        && (1..=9999).contains(&year);
+    if !valid {
+        return Err(format!("time = \"{text}\" is not a date and time of day"));
+    }
+    Ok(LocalTime {
+        year,
+        month,
+        day,
+        hour,
+        minute,
+        second,
+        timezone,
+    })
+}
+
+/// The day of the year (1–366) of a date.
+fn day_of_year(t: &LocalTime) -> u32 {
+    let leap = (t.year % 4 == 0 && t.year % 100 != 0) || t.year % 400 == 0;
+    let days = [
+        31,
+        if leap { 29 } else { 28 },
+        31,
+        30,
+        31,
+        30,
+        31,
+        31,
+        30,
+        31,
+        30,
+        31,
+    ];
+    days[..(t.month as usize - 1)].iter().sum::<u32>() + t.day
+}
+
+/// `[site]` and `[sky]` as the daylight outside; errors name the table's line.
+fn daylight(
+    site: Option<Spanned<SiteToml>>,
+    sky: Option<Spanned<SkyToml>>,
+    at: &dyn Fn(Range<usize>, String) -> Error,
+) -> Result<Option<Daylight>> {
+    let Some(sky) = sky else {
+        return match site {
+            Some(s) => Err(at(
+                s.span(),
+                "[site] without a [sky]: give the sky (model = \"cie-overcast\", say)".into(),
+            )),
+            None => Ok(None),
+        };
+    };
+    let (sky_span, k) = (sky.span(), sky.into_inner());
+    let fail = |problem: String| at(sky_span.clone(), format!("[sky] {problem}"));
+    let (site_span, s) = match site {
+        Some(s) => (Some(s.span()), s.into_inner()),
+        None => (
+            None,
+            SiteToml {
+                latitude: None,
+                longitude: None,
+                timezone: None,
+                north: None,
+                up: None,
+                ground_reflectance: None,
+            },
+        ),
+    };
+    let site_fail = |problem: String| match &site_span {
+        Some(span) => at(span.clone(), format!("[site] {problem}")),
+        None => fail(problem),
+    };
+    for (name, value, range) in [
+        ("latitude", s.latitude, -90.0..=90.0),
+        ("longitude", s.longitude, -180.0..=180.0),
+        ("timezone", s.timezone, -14.0..=14.0),
+        ("ground_reflectance", s.ground_reflectance, 0.0..=1.0),
+    ] {
+        if let Some(v) = value.filter(|v| !range.contains(v)) {
+            return Err(site_fail(format!(
+                "{name} = {v} is outside {} to {}",
+                range.start(),
+                range.end()
+            )));
+        }
+    }
+    let sun_needed = !matches!(k.model.as_str(), "cie-overcast" | "uniform");
+    let model = match (k.model.as_str(), k.kind) {
+        ("cie-overcast", None) => SkyModel::CieOvercast,
+        ("uniform", None) => SkyModel::Uniform,
+        ("cie", Some(t)) if (1..=15).contains(&t) => SkyModel::Cie(t),
+        ("cie", Some(t)) => return Err(fail(format!("type = {t}: the general skies are 1 to 15"))),
+        ("cie", None) => return Err(fail("model = \"cie\" needs type = 1 to 15".into())),
+        ("perez", None) => SkyModel::Perez {
+            clearness: 1.0,
+            brightness: 0.2,
+        },
+        (m @ ("cie-overcast" | "uniform" | "perez"), Some(_)) => {
+            return Err(fail(format!("type is for model = \"cie\", not \"{m}\"")))
+        }
+        (other, _) => {
+            return Err(fail(format!(
+                "model = \"{other}\": one of \"cie-overcast\", \"uniform\", \"cie\", \"perez\""
+            )))
+        }
+    };
+    let diffuse = match k.diffuse_horizontal {
+        Some(e) if e.is_finite() && e >= 0.0 => e,
+        Some(e) => {
+            return Err(fail(format!(
+                "diffuse_horizontal = {e} is not an illuminance ≥ 0"
+            )))
+        }
+        None if !sun_needed => 10_000.0,
+        None => {
+            return Err(fail(format!(
+                "model = \"{}\" needs diffuse_horizontal",
+                k.model
+            )))
+        }
+    };
+    let direct = match k.direct_normal {
+        Some(e) if e.is_finite() && e >= 0.0 => e,
+        Some(e) => {
+            return Err(fail(format!(
+                "direct_normal = {e} is not an illuminance ≥ 0"
+            )))
+        }
+        None => 0.0,
+    };
+    // The sun: from the time at the site, or given.
+    let (sun, day) = match (k.time.as_deref(), k.sun_altitude, k.sun_azimuth) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            return Err(fail(
+                "give the time or sun_altitude and sun_azimuth, not both".into(),
+            ))
+        }
+        (Some(text), None, None) => {
+            let (Some(latitude), Some(longitude), Some(timezone)) =
+                (s.latitude, s.longitude, s.timezone)
+            else {
+                return Err(site_fail(
+                    "a sun from the time needs the site's latitude, longitude and timezone".into(),
+                ));
+            };
+            let time = local_time(text, timezone).map_err(&fail)?;
+            let observer = Observer {
+                latitude,
+                longitude,
+                elevation: 0.0,
+                pressure: 1010.0,
+                temperature: 10.0,
+            };
+            let year = f64::from(time.year) + (f64::from(time.month) - 0.5) / 12.0;
+            let sun = sun_position(&time, &observer, crate::daylight::spa::delta_t(year));
+            (Some((sun.zenith, sun.azimuth)), Some(day_of_year(&time)))
+        }
+        (None, Some(alt), Some(az)) => {
+            if !((-90.0..=90.0).contains(&alt) && az.is_finite()) {
+                return Err(fail(format!(
+                    "sun_altitude = {alt} must be within −90 to 90 and sun_azimuth finite"
+                )));
+            }
+            (Some((90.0 - alt, az.rem_euclid(360.0))), None)
+        }
+        (None, Some(_), None) | (None, None, Some(_)) => {
+            return Err(fail("give both sun_altitude and sun_azimuth".into()))
+        }
+        (None, None, None) => (None, None),
+    };
+    if sun.is_none() && (sun_needed || direct > 0.0) {
+        return Err(fail(format!(
+            "model = \"{}\"{} needs the sun's position: a time (with the site's latitude, \
+             longitude and timezone) or sun_altitude and sun_azimuth",
+            k.model,
+            if direct > 0.0 {
+                " with direct_normal"
+            } else {
+                ""
+            }
+        )));
+    }
+    let up_sun = sun.filter(|&(zenith, _)| zenith < 90.0);
+    if direct > 0.0 && up_sun.is_some() {
+        return Err(fail(
+            "direct_normal > 0: the sun's own light is not lit yet in this version (the sky is); \
+             set direct_normal = 0 to light the scene by the sky alone"
+                .into(),
+        ));
+    }
+    let (zenith, azimuth) = sun.unwrap_or((0.0, 0.0));
+    let model = match model {
+        SkyModel::Perez { .. } => {
+            let (clearness, brightness) =
+                crate::daylight::sky::perez_parameters(diffuse, direct, zenith.min(90.0), day);
+            SkyModel::Perez {
+                clearness,
+                brightness,
+            }
+        }
+        m => m,
+    };
+    let sky = Sky::new(model, zenith, azimuth, diffuse).map_err(|e| fail(e.to_string()))?;
+    let direct_horizontal = up_sun.map_or(0.0, |(z, _)| direct * z.to_radians().cos());
+    let up = s.up.map_or(Vec3::Y, Vec3::from);
+    let north = s.north.map_or(-Vec3::Z, Vec3::from);
+    Daylight::new(
+        sky,
+        up,
+        north,
+        s.ground_reflectance.unwrap_or(0.2),
+        diffuse,
+        sun,
+        direct_horizontal,
+    )
+    .map(Some)
+    .map_err(|e| site_fail(e.to_string()))
 }
 
 #[cfg(test)]

@@ -22,6 +22,8 @@ pub struct Grid {
     /// uniformity U0 = Emin / Ēm.
     pub(crate) target_em: Option<f64>,
     pub(crate) target_u0: Option<f64>,
+    pub(crate) target_df: Option<f64>,
+    pub(crate) target_df_median: Option<f64>,
 }
 
 impl Grid {
@@ -77,6 +79,8 @@ impl Grid {
             n_v,
             target_em: None,
             target_u0: None,
+            target_df: None,
+            target_df_median: None,
         })
     }
 
@@ -108,6 +112,36 @@ impl Grid {
     /// The uniformity Emin / Ēm the grid must reach, if it has a target.
     pub fn target_u0(&self) -> Option<f64> {
         self.target_u0
+    }
+
+    /// The grid with daylight-factor targets (%): the average and the median it must reach.
+    pub fn with_df_targets(
+        mut self,
+        average: Option<f64>,
+        median: Option<f64>,
+    ) -> Result<Grid, String> {
+        for (name, value) in [("target_df", average), ("target_df_median", median)] {
+            if let Some(v) = value {
+                if !(v.is_finite() && v > 0.0 && v <= 100.0) {
+                    return Err(format!(
+                        "{name} {v} must be a daylight factor in (0, 100] %"
+                    ));
+                }
+            }
+        }
+        self.target_df = average;
+        self.target_df_median = median;
+        Ok(self)
+    }
+
+    /// The average daylight factor (%) the grid must reach, if it has a target.
+    pub fn target_df(&self) -> Option<f64> {
+        self.target_df
+    }
+
+    /// The median daylight factor (%) the grid must reach, if it has a target.
+    pub fn target_df_median(&self) -> Option<f64> {
+        self.target_df_median
     }
 
     /// Its name, unique in the scene.

@@ -263,12 +263,24 @@ pub struct Scene {
     pub(crate) bounds: Bounds,
     /// Things worth telling the user that did not stop loading (each said once).
     pub(crate) warnings: Vec<String>,
+    /// The sky and ground outside (scene-format v4), if daylight enters the scene.
+    pub(crate) daylight: Option<crate::daylight::Daylight>,
 }
 
 impl Scene {
     /// Where it came from: the scene file, or the name a host program gave.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// The daylight outside (`[site]` and `[sky]`), if any.
+    pub fn daylight(&self) -> Option<&crate::daylight::Daylight> {
+        self.daylight.as_ref()
+    }
+
+    /// Lets daylight in (or, with `None`, keeps it out): a host's own sky.
+    pub fn set_daylight(&mut self, daylight: Option<crate::daylight::Daylight>) {
+        self.daylight = daylight;
     }
 
     /// Materials, indexed by [`Surface::material`].
@@ -509,6 +521,7 @@ impl Scene {
         scene.luminaires = luminaires;
         scene.units = file.units;
         scene.grids = file.grids;
+        scene.daylight = file.daylight;
         warnings.append(&mut scene.warnings);
         scene.warnings = warnings;
         Ok(scene)
@@ -604,6 +617,7 @@ impl Scene {
             solver,
             bounds,
             warnings,
+            daylight: None,
         })
     }
 

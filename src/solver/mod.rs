@@ -76,6 +76,10 @@ pub struct Solution {
     pub(crate) row_scale: Vec<f32>,
     /// Light by way of specular surfaces (none in a scene without them).
     pub(crate) specular: Option<specular::Transfer>,
+    /// Per sample: the daylight entering straight from the sky and the ground (empty without
+    /// daylight). Exact at each sample, not interpolated in warm starts; the image interpolates
+    /// it with the rest of the samples' light.
+    pub(crate) daylight: Vec<DVec3>,
 }
 
 impl Solution {
@@ -159,7 +163,8 @@ impl Solution {
                 + vec_bytes(&self.direct)
                 + vec_bytes(&self.closed)
                 + vec_bytes(&self.covered)
-                + vec_bytes(&self.row_scale),
+                + vec_bytes(&self.row_scale)
+                + vec_bytes(&self.daylight),
             specular: self.specular.as_ref().map_or(0, specular::Transfer::bytes),
             maps: self.maps.iter().map(|m| vec_bytes(&m.triangles)).sum(),
         }
@@ -267,6 +272,9 @@ impl Solution {
             .sum()
     }
 }
+
+/// Rays per sample towards the sky and the ground, where daylight enters a scene.
+const SKY_RAYS: u32 = 128;
 
 /// The largest ε a solve takes, in diagonals of the scene's bounds.
 pub const MAX_EPSILON_DIAGONALS: f32 = 100.0;
@@ -442,6 +450,7 @@ fn solve_with(
         reporter: Reporter::new(progress),
         ranks,
         light_scale: glam::DVec3::ONE,
+        entering: crate::daylight::entering::Entering::of(scene, SKY_RAYS),
     };
 
     // Round 0: Poisson disk on every reflecting side.
@@ -467,6 +476,7 @@ fn solve_with(
         closed: Vec::new(),
         covered: Vec::new(),
         row_scale: Vec::new(),
+        daylight: Vec::new(),
         specular: solve
             .specular
             .as_ref()

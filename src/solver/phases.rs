@@ -45,6 +45,8 @@ pub(super) struct Solve<'a> {
     pub(super) specular: Option<(Specular, Lights)>,
     /// What the samples' direct light is scaled by to balance the lights' power (`balance`).
     pub(super) light_scale: DVec3,
+    /// The daylight entering, where the scene has a sky.
+    pub(super) entering: Option<crate::daylight::entering::Entering<'a>>,
 }
 
 /// Samples an adaptive step (or the initial placement) added.
@@ -327,6 +329,7 @@ impl Solve<'_> {
         solution.covered.extend(covered);
         let at = (points.as_slice(), ids.as_slice());
         queries += self.specular_light(solution, round, first_new, at)?;
+        queries += self.daylight(solution, round, at)?;
         warm::start(
             scene,
             solution,
@@ -337,17 +340,57 @@ impl Solve<'_> {
             options.alpha,
             (threads, self.ranks),
         )?;
+        if round == 0 && !solution.daylight.is_empty() {
+            // Daylight is a source too: what enters is what the shooting measures against.
+            let entering: DVec3 = (0..n)
+                .map(|k| solution.daylight[k] * solution.samples.area[k])
+                .sum();
+            solution.ledger.emitted += entering;
+        }
         if round == 0 {
             // Direct light that reached no sample area left the scene.
             let received: DVec3 = (0..n)
                 .map(|k| {
-                    let exact = solution.direct[k].irradiance + warm::specular_direct(solution, k);
+                    let exact =
+                        solution.direct[k].irradiance + warm::exact_beyond_direct(solution, k);
                     exact * solution.samples.area[k]
                 })
                 .sum();
             solution.ledger.escaped += solution.ledger.emitted - received;
         }
         Ok(queries)
+    }
+
+    /// The daylight entering at the new samples (`daylight::entering`); the queries.
+    fn daylight(
+        &mut self,
+        solution: &mut Solution,
+        round: u32,
+        (points, ids): (&[(Vec3, Vec3)], &[u32]),
+    ) -> Result<u64> {
+        let Some(entering) = &self.entering else {
+            return Ok(0);
+        };
+        let n = solution.samples.len();
+        let mut out = vec![DVec3::ZERO; points.len()];
+        if self.reporter.stopped() {
+            solution.daylight.extend(out);
+            return Ok(0);
+        }
+        let (vis, seed) = (self.vis, self.options.seed);
+        let queries = std::sync::atomic::AtomicU64::new(0);
+        let work = |first: usize, chunk: &mut [DVec3]| {
+            let range = first..first + chunk.len();
+            let (got, q) = entering.at(vis, &points[range.clone()], &ids[range], seed)?;
+            chunk.copy_from_slice(&got);
+            queries.fetch_add(q, std::sync::atomic::Ordering::Relaxed);
+            Ok(())
+        };
+        let base = self.base(Phase::DirectLight, round, n);
+        let threads = self.options.threads.max(1);
+        for_chunks_reporting(&mut out, 64, threads, work, &mut self.reporter.part(base))?;
+        solution.daylight.extend(out);
+        Ok(queries.into_inner())
     }
 
     /// The new samples' light by way of specular surfaces that is not interpolated: their

@@ -33,15 +33,18 @@ pub(crate) fn emission(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
     std::f64::consts::PI * scene.material_of(surface_of(side)).ke.as_dvec3()
 }
 
-/// Sample k's light from the lights by way of specular surfaces that is not interpolated: by
-/// glossy bounces, through chains of images, and the photons' (0 without specular surfaces).
-pub(crate) fn specular_direct(solution: &Solution, k: usize) -> DVec3 {
-    solution.specular.as_ref().map_or(DVec3::ZERO, |t| {
-        [&t.direct, &t.far, &t.caustic]
-            .iter()
-            .map(|v| v.get(k).copied().unwrap_or_default())
-            .sum()
-    })
+/// Sample k's light that is exact at it but not its direct light: from the lights by way of
+/// specular surfaces (by glossy bounces, through chains of images, the photons') and the
+/// daylight entering (0 without either).
+pub(crate) fn exact_beyond_direct(solution: &Solution, k: usize) -> DVec3 {
+    let daylight = solution.daylight.get(k).copied().unwrap_or_default();
+    daylight
+        + solution.specular.as_ref().map_or(DVec3::ZERO, |t| {
+            [&t.direct, &t.far, &t.caustic]
+                .iter()
+                .map(|v| v.get(k).copied().unwrap_or_default())
+                .sum()
+        })
 }
 
 /// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their
@@ -95,7 +98,7 @@ pub(crate) fn start(
                     wsum += w;
                     // What is exact at the new sample (its direct light, and the lights' light
                     // by way of glossy bounces) is not interpolated.
-                    let exact = shared.direct[j].irradiance + specular_direct(shared, j);
+                    let exact = shared.direct[j].irradiance + exact_beyond_direct(shared, j);
                     indirect += w * (shared.irradiance[j] - exact);
                     shot += w * (rho * shared.irradiance[j] - shared.unshot[j]);
                 }
@@ -104,7 +107,7 @@ pub(crate) fn start(
                 indirect /= wsum;
                 shot /= wsum;
             }
-            let h = arrivals[k - first_new].irradiance + indirect + specular_direct(shared, k);
+            let h = arrivals[k - first_new].irradiance + indirect + exact_beyond_direct(shared, k);
             *o = (h, rho * h - shot, emission(scene, samples, k) + rho * h);
         }
         Ok(())

@@ -1,0 +1,349 @@
+//! Daylight entering the model: the irradiance the sky and the ground give a point inside
+//! through openings and glass, E = ∫ L(ω) T(ω) cos θ dω over the directions whose ray leaves
+//! the model (`docs/method.md` §23).
+//!
+//! Most of a room's hemisphere is wall, so the rays are aimed at where light can enter: the
+//! **portals**, found once per scene, are the thin panes' triangles and the holes in the mesh
+//! (loops of edges that only one triangle uses, fanned from their centroid: a window cut in a
+//! wall, the open top of a court). Each receiver draws most of its rays towards the portals
+//! (a portal triangle picked by its approximate solid angle, a point uniform on it) and the
+//! rest cosine-weighted over its hemisphere, and weighs every ray by the balance heuristic over
+//! both ways of drawing it (Veach 1997, the multi-sample form): where the portals miss an
+//! opening (a gap between separate wall pieces, say) the hemisphere's rays still find it, so
+//! the estimate is unbiased whatever the portals; where they find them, a small window in a
+//! large room is sampled as densely as a large one. A ray's light passes thin panes and slabs
+//! with the glass's Fresnel transmittance (`specular::shadow`), and anything else blocks it.
+
+use std::collections::HashMap;
+
+use glam::{DVec3, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use super::Daylight;
+use crate::error::Result;
+use crate::sampling::poisson::side_seed;
+use crate::scene::{Kind, Scene};
+use crate::specular::shadow::{self, LightPath};
+use crate::specular::Specular;
+use crate::visibility::{Ray, Visibility};
+
+/// Portal triangles a scene may have before they cost more than they save (every receiver
+/// weighs each one, and every ray is tested against each one): beyond, rays go over the
+/// hemisphere only.
+const MAX_PORTALS: usize = 512;
+
+/// The share of a receiver's rays aimed at the portals (where it has any in front).
+const PORTAL_SHARE: f64 = 0.75;
+
+/// A salt for the receivers' seeds: their sky rays are not their shadow rays.
+const SALT: u64 = 0x5ca1_ab1e_da11_9447;
+
+/// One portal triangle.
+#[derive(Clone, Debug)]
+struct Portal {
+    vertices: [Vec3; 3],
+    normal: Vec3,
+    area: f32,
+    centroid: Vec3,
+}
+
+/// The daylight entering a scene, ready to be measured at points.
+pub(crate) struct Entering<'a> {
+    daylight: &'a Daylight,
+    portals: Vec<Portal>,
+    specular: Option<Specular>,
+    lift: f32,
+    /// How far a ray is followed: past the scene's bounds from anywhere inside.
+    far: f32,
+    /// Rays per receiver.
+    rays: u32,
+}
+
+/// The portal triangles of a scene: its thin panes and its holes.
+fn portals(scene: &Scene) -> Vec<Portal> {
+    let mut out = Vec::new();
+    let mut push = |vertices: [Vec3; 3]| {
+        let e = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
+        let area = 0.5 * e.length();
+        if area > 0.0 && area.is_finite() {
+            out.push(Portal {
+                vertices,
+                normal: e.normalize(),
+                area,
+                centroid: (vertices[0] + vertices[1] + vertices[2]) / 3.0,
+            });
+        }
+    };
+    for t in &scene.triangles {
+        if matches!(
+            scene.material_of(t.surface).kind,
+            Kind::Glass { thin: true, .. }
+        ) {
+            push(t.vertices);
+        }
+    }
+    // Edges used by one triangle only (corners compared by their bits).
+    let key = |v: Vec3| (v + Vec3::ZERO).to_array().map(f32::to_bits);
+    let mut uses: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::new();
+    for t in &scene.triangles {
+        for i in 0..3 {
+            let (a, b) = (key(t.vertices[i]), key(t.vertices[(i + 1) % 3]));
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut next: HashMap<[u32; 3], Vec<[u32; 3]>> = HashMap::new();
+    let mut position: HashMap<[u32; 3], Vec3> = HashMap::new();
+    for t in &scene.triangles {
+        for v in t.vertices {
+            position.insert(key(v), v);
+        }
+    }
+    let mut boundary: Vec<_> = uses
+        .into_iter()
+        .filter(|&(_, n)| n == 1)
+        .map(|(e, _)| e)
+        .collect();
+    // A fixed order: the loops, and so the portals, do not depend on the hash map's.
+    boundary.sort_unstable();
+    for &(a, b) in &boundary {
+        next.entry(a).or_default().push(b);
+        next.entry(b).or_default().push(a);
+    }
+    let mut starts: Vec<[u32; 3]> = next.keys().copied().collect();
+    starts.sort_unstable();
+    for start in starts {
+        // Walk a loop, taking each boundary edge once.
+        let mut ring = vec![start];
+        let mut at = start;
+        while let Some(to) = next.get_mut(&at).and_then(Vec::pop) {
+            if let Some(back) = next.get_mut(&to) {
+                if let Some(i) = back.iter().position(|&v| v == at) {
+                    back.swap_remove(i);
+                }
+            }
+            if to == start {
+                break;
+            }
+            ring.push(to);
+            at = to;
+        }
+        if ring.len() < 3 {
+            continue;
+        }
+        let points: Vec<Vec3> = ring.iter().map(|k| position[k]).collect();
+        let centroid = points.iter().sum::<Vec3>() / points.len() as f32;
+        for i in 0..points.len() {
+            push([centroid, points[i], points[(i + 1) % points.len()]]);
+        }
+    }
+    out
+}
+
+/// Where a ray from `origin` along unit `dir` crosses a triangle, if it does (t > 0).
+fn crossing(origin: Vec3, dir: Vec3, [a, b, c]: [Vec3; 3]) -> Option<f32> {
+    let (e1, e2) = (b - a, c - a);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - a;
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inv;
+    (t > 0.0).then_some(t)
+}
+
+impl<'a> Entering<'a> {
+    /// The scene's daylight entering, `rays` rays per receiver; `None` for a scene without
+    /// daylight.
+    pub(crate) fn of(scene: &'a Scene, rays: u32) -> Option<Entering<'a>> {
+        let daylight = scene.daylight.as_ref()?;
+        let mut portals = portals(scene);
+        if portals.len() > MAX_PORTALS {
+            portals.clear();
+        }
+        let specular = Some(Specular::of(scene)).filter(Specular::any);
+        Some(Entering {
+            daylight,
+            portals,
+            specular,
+            lift: crate::visibility::lift(scene),
+            far: 2.0 * scene.bounds.diagonal() + 1.0,
+            rays: rays.max(1),
+        })
+    }
+
+    /// Daylight irradiance at each (position, normal), receiver i drawing its rays from a seed
+    /// of (`seed`, `ids[i]`); the visibility queries made.
+    pub(crate) fn at(
+        &self,
+        vis: &dyn Visibility,
+        points: &[(Vec3, Vec3)],
+        ids: &[u32],
+        seed: u64,
+    ) -> Result<(Vec<DVec3>, u64)> {
+        let n_rays = self.rays as usize;
+        let mut dirs: Vec<Vec3> = Vec::with_capacity(points.len() * n_rays);
+        // Per ray: cos θ at the receiver over the mixture's density × rays (the weight of
+        // its light), 0 where it points below the receiver's horizon.
+        let mut weights: Vec<f64> = Vec::with_capacity(points.len() * n_rays);
+        let mut solid: Vec<f64> = Vec::new();
+        for (&(x, n), &id) in points.iter().zip(ids) {
+            let from = x + self.lift * n;
+            let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, SALT));
+            // Each portal's weight: its solid angle from the receiver times the cosine there,
+            // roughly (a near portal is held to its area so the weight stays finite).
+            solid.clear();
+            let mut total = 0.0;
+            for p in &self.portals {
+                let front = p.vertices.iter().any(|&v| (v - from).dot(n) > 0.0);
+                let w = if front {
+                    let d = p.centroid - from;
+                    let d2 = d.length_squared().max(p.area);
+                    let dir = d / d.length().max(1e-12);
+                    f64::from(p.area * p.normal.dot(dir).abs() * dir.dot(n).max(0.05) / d2)
+                } else {
+                    0.0
+                };
+                total += w;
+                solid.push(total);
+            }
+            let aimed = if total > 0.0 {
+                (PORTAL_SHARE * n_rays as f64).round() as usize
+            } else {
+                0
+            };
+            let spread = n_rays - aimed;
+            let (t, b) = n.any_orthonormal_pair();
+            for i in 0..n_rays {
+                let dir = if i < aimed {
+                    let pick = rng.random::<f64>() * total;
+                    let j = solid.partition_point(|&c| c <= pick).min(solid.len() - 1);
+                    let p = &self.portals[j];
+                    let at = crate::light::in_triangle(p.vertices, rng.random(), rng.random());
+                    (at - from).normalize_or_zero()
+                } else {
+                    // Cosine-weighted, stratified over the receiver's hemisphere.
+                    let k = i - aimed;
+                    let u = (k as f64 + rng.random::<f64>()) / spread as f64;
+                    let phi = std::f64::consts::TAU * rng.random::<f64>();
+                    let r = u.sqrt();
+                    (t * (r * phi.cos()) as f32
+                        + b * (r * phi.sin()) as f32
+                        + n * (1.0 - u).max(0.0).sqrt() as f32)
+                        .normalize_or_zero()
+                };
+                let cos = f64::from(dir.dot(n));
+                let weight = if cos > 0.0 {
+                    // The density of drawing `dir` either way, times the rays drawn so.
+                    let mut portal_pdf = 0.0;
+                    if aimed > 0 {
+                        let mut below = 0.0;
+                        for (p, &c) in self.portals.iter().zip(&solid) {
+                            let w = c - below;
+                            below = c;
+                            if w <= 0.0 {
+                                continue;
+                            }
+                            if let Some(t) = crossing(from, dir, p.vertices) {
+                                let cos_p = f64::from(p.normal.dot(dir).abs()).max(1e-9);
+                                portal_pdf += w / total * f64::from(t) * f64::from(t)
+                                    / (f64::from(p.area) * cos_p);
+                            }
+                        }
+                    }
+                    let density =
+                        spread as f64 * cos / std::f64::consts::PI + aimed as f64 * portal_pdf;
+                    if density > 0.0 {
+                        cos / density
+                    } else {
+                        0.0
+                    }
+                } else {
+                    0.0
+                };
+                dirs.push(dir);
+                weights.push(weight);
+            }
+        }
+        // Which rays leave the model, and what glass passes.
+        let mut shares = vec![DVec3::ZERO; dirs.len()];
+        let mut queries = 0;
+        let live: Vec<usize> = (0..dirs.len()).filter(|&i| weights[i] > 0.0).collect();
+        let from_of = |i: usize| {
+            let (x, n) = points[i / n_rays];
+            x + self.lift * n
+        };
+        match &self.specular {
+            Some(spec) => {
+                let paths: Vec<LightPath> = live
+                    .iter()
+                    .map(|&i| LightPath {
+                        from: from_of(i),
+                        to: from_of(i) + dirs[i] * self.far,
+                        chain: &[],
+                    })
+                    .collect();
+                let mut out = vec![DVec3::ZERO; paths.len()];
+                queries += shadow::arriving(spec, vis, self.lift, &paths, &mut out)?;
+                for (&i, s) in live.iter().zip(out) {
+                    shares[i] = s;
+                }
+            }
+            None => {
+                // Rays, not segments: a segment this long ignores hits within 10⁻⁵ of its
+                // length of its start, and a sample in a corner lies nearer than that to the
+                // next wall (light leaked into a closed box that way).
+                let rays: Vec<Ray> = live
+                    .iter()
+                    .map(|&i| Ray {
+                        origin: from_of(i),
+                        dir: dirs[i],
+                        t_min: 0.0,
+                        t_max: self.far,
+                    })
+                    .collect();
+                let mut hits = vec![None; rays.len()];
+                vis.intersect(&rays, &mut hits)?;
+                queries += rays.len() as u64;
+                for (&i, hit) in live.iter().zip(hits) {
+                    shares[i] = if hit.is_some() {
+                        DVec3::ZERO
+                    } else {
+                        DVec3::ONE
+                    };
+                }
+            }
+        }
+        let mut out = vec![DVec3::ZERO; points.len()];
+        for i in live {
+            let l = self.daylight.radiance(dirs[i]);
+            out[i / n_rays] += shares[i] * (l * weights[i]);
+        }
+        Ok((out, queries))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ray_crosses_a_triangle_where_it_lies() {
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let t = crossing(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, tri).unwrap();
+        assert!((t - 1.0).abs() < 1e-6);
+        assert!(crossing(Vec3::new(0.8, 0.8, 1.0), -Vec3::Z, tri).is_none());
+        assert!(crossing(Vec3::new(0.2, 0.2, 1.0), Vec3::Z, tri).is_none());
+    }
+}

@@ -1,0 +1,183 @@
+//! A scene's daylight for one moment: where the building stands (its north and zenith in scene
+//! directions), the sky, and the ground below the horizon (scene-format v4 `[site]`, `[sky]`).
+
+use glam::{DVec3, Vec3};
+
+use super::sky::Sky;
+use crate::error::{Error, Result};
+
+/// The daylight outside a scene: what a ray leaving the model sees.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Daylight {
+    up: DVec3,
+    north: DVec3,
+    east: DVec3,
+    sky: Sky,
+    /// The sky's illuminance on an unobstructed horizontal plane (the daylight factor's
+    /// denominator).
+    diffuse_horizontal: f64,
+    /// Uniform luminance of the ground below the horizon.
+    ground: f64,
+    /// The sun's zenith angle and azimuth (degrees), where the sky has one.
+    sun: Option<(f64, f64)>,
+}
+
+impl Daylight {
+    /// Daylight from `sky` over a site whose zenith is `up` and whose north is `north` (scene
+    /// directions; north need not be horizontal: its horizontal part is taken), with the
+    /// ground below the horizon reflecting `ground_reflectance` of the sky's light (and the
+    /// sun's, `direct_horizontal`, its direct normal illuminance times the sine of its
+    /// altitude).
+    pub fn new(
+        sky: Sky,
+        up: Vec3,
+        north: Vec3,
+        ground_reflectance: f64,
+        diffuse_horizontal: f64,
+        sun: Option<(f64, f64)>,
+        direct_horizontal: f64,
+    ) -> Result<Daylight> {
+        let bad = |problem: String| {
+            Err(Error::Option {
+                option: "site",
+                problem,
+            })
+        };
+        let up = up.as_dvec3();
+        if !(up.is_finite() && up.length() > 1e-6) {
+            return bad(format!("up {up} is not a direction"));
+        }
+        let up = up.normalize();
+        let north = north.as_dvec3();
+        let horizontal = north - up * north.dot(up);
+        if !(horizontal.is_finite() && horizontal.length() > 1e-3 * north.length().max(1e-30)) {
+            return bad(format!(
+                "north {north} has no horizontal part (up is {up}): it must point along the \
+                 ground"
+            ));
+        }
+        if !(0.0..=1.0).contains(&ground_reflectance) {
+            return bad(format!(
+                "ground_reflectance {ground_reflectance} is not within 0 to 1"
+            ));
+        }
+        if !(diffuse_horizontal.is_finite()
+            && diffuse_horizontal >= 0.0
+            && direct_horizontal.is_finite()
+            && direct_horizontal >= 0.0)
+        {
+            return bad("the sky's and the sun's illuminance must be finite and ≥ 0".into());
+        }
+        let north = horizontal.normalize();
+        Ok(Daylight {
+            up,
+            north,
+            east: north.cross(up),
+            sky,
+            diffuse_horizontal,
+            ground: ground_reflectance * (diffuse_horizontal + direct_horizontal)
+                / std::f64::consts::PI,
+            sun,
+        })
+    }
+
+    /// The sky.
+    pub fn sky(&self) -> &Sky {
+        &self.sky
+    }
+
+    /// The zenith, a unit scene direction.
+    pub fn up(&self) -> Vec3 {
+        self.up.as_vec3()
+    }
+
+    /// True north along the ground, a unit scene direction.
+    pub fn north(&self) -> Vec3 {
+        self.north.as_vec3()
+    }
+
+    /// The sky's illuminance on an unobstructed horizontal plane.
+    pub fn diffuse_horizontal(&self) -> f64 {
+        self.diffuse_horizontal
+    }
+
+    /// The luminance of the ground below the horizon.
+    pub fn ground_luminance(&self) -> f64 {
+        self.ground
+    }
+
+    /// The sun's zenith angle and azimuth (degrees, clockwise from north), if the sky has one.
+    pub fn sun(&self) -> Option<(f64, f64)> {
+        self.sun
+    }
+
+    /// The scene direction of a zenith angle and azimuth (degrees).
+    pub fn direction(&self, zenith: f64, azimuth: f64) -> Vec3 {
+        let (t, a) = (zenith.to_radians(), azimuth.to_radians());
+        (self.up * t.cos() + (self.north * a.cos() + self.east * a.sin()) * t.sin()).as_vec3()
+    }
+
+    /// The luminance seen looking along scene direction `dir` (need not be unit) from inside
+    /// the model out: the sky above the horizon, the ground below (a sharp horizon).
+    pub fn radiance(&self, dir: Vec3) -> f64 {
+        let d = dir.as_dvec3().normalize_or_zero();
+        let up = d.dot(self.up);
+        if up <= 0.0 {
+            return if d == DVec3::ZERO { 0.0 } else { self.ground };
+        }
+        let theta = up.clamp(-1.0, 1.0).acos();
+        let phi = d.dot(self.east).atan2(d.dot(self.north));
+        self.sky.luminance(theta, phi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::daylight::SkyModel;
+
+    #[test]
+    fn scene_directions_turn_into_the_skys() {
+        // y up, north −z: east is +x. A CIE type 12 sky with the sun due south at 40° altitude
+        // is brightest towards the sun.
+        let sky = Sky::new(SkyModel::Cie(12), 50.0, 180.0, 10_000.0).unwrap();
+        let d = Daylight::new(
+            sky,
+            Vec3::Y,
+            -Vec3::Z,
+            0.2,
+            10_000.0,
+            Some((50.0, 180.0)),
+            0.0,
+        )
+        .unwrap();
+        let south = d.direction(50.0, 180.0);
+        assert!(
+            south.abs_diff_eq(Vec3::new(0.0, 0.643, 0.766), 1e-3),
+            "{south}"
+        );
+        let east = d.direction(90.0, 90.0);
+        assert!(east.abs_diff_eq(Vec3::X, 1e-6), "{east}");
+        let near_sun = d.radiance(south);
+        let north = d.radiance(d.direction(50.0, 0.0));
+        assert!(near_sun > 3.0 * north, "{near_sun} vs {north}");
+        // Below the horizon the ground: ρ E_h / π.
+        let ground = d.radiance(Vec3::new(0.3, -1.0, 0.2));
+        assert!((ground - 0.2 * 10_000.0 / std::f64::consts::PI).abs() < 1e-9);
+        // A tilted north is taken along the ground.
+        let tilted = Daylight::new(
+            Sky::new(SkyModel::Uniform, 0.0, 0.0, 1.0).unwrap(),
+            Vec3::Y,
+            Vec3::new(0.0, 0.5, -1.0),
+            0.2,
+            1.0,
+            None,
+            0.0,
+        )
+        .unwrap();
+        assert!(tilted.north().abs_diff_eq(-Vec3::Z, 1e-6));
+        // North along up is refused.
+        let sky = Sky::new(SkyModel::Uniform, 0.0, 0.0, 1.0).unwrap();
+        assert!(Daylight::new(sky, Vec3::Y, Vec3::Y, 0.2, 1.0, None, 0.0).is_err());
+    }
+}
