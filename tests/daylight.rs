@@ -222,6 +222,101 @@ fn a_point_under_a_roof_opening_gets_the_sky_component() {
     }
 }
 
+#[test]
+fn the_sun_through_a_roof_opening_gives_its_direct_normal_illuminance() {
+    // The sun overhead, no sky, black inside: in the patch the floor gets E_n (the disc's
+    // rays all within 0.27° of the normal), or E_n (1 − R₀)/(1 + R₀) through the pane
+    // (R₀ = ((n − 1)/(n + 1))², Fresnel at normal incidence); outside the patch nothing.
+    let en: f64 = 50_000.0;
+    for pane in [false, true] {
+        let mut scene = roof_light(0.0, pane);
+        let sky = Sky::new(SkyModel::Uniform, 0.0, 0.0, 0.0).unwrap();
+        let daylight =
+            Daylight::new(sky, Vec3::Y, -Vec3::Z, 0.0, 0.0, Some((0.0, 0.0)), en).unwrap();
+        scene.set_daylight(Some(daylight));
+        let r0 = ((1.52f64 - 1.0) / (1.52 + 1.0)).powi(2);
+        let expected = if pane {
+            en * (1.0 - r0) / (1.0 + r0)
+        } else {
+            en
+        };
+        for backend in Backend::available() {
+            let vis = backend.build(&scene).unwrap();
+            let options = Options {
+                rounds: 0,
+                ..Options::default()
+            };
+            let s = meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue)
+                .unwrap();
+            for (origin, want) in [(1.75, expected), (3.25, 0.0)] {
+                let grid = Grid::new(
+                    "spot",
+                    Vec3::new(origin, 0.01, origin),
+                    Vec3::new(0.5, 0.0, 0.0),
+                    Vec3::new(0.0, 0.0, 0.5),
+                    Some(Vec3::Y),
+                    Some(0.5),
+                )
+                .unwrap();
+                let e = illuminance(
+                    &scene,
+                    &s,
+                    vis.as_ref(),
+                    &grid,
+                    &LuxOptions::default(),
+                    &mut |_| Control::Continue,
+                )
+                .unwrap();
+                let got = e.values[0].x;
+                println!("pane {pane} {backend} at {origin}: {got:.2} lx vs {want:.2}");
+                assert!(
+                    (got - want).abs() <= 1e-4 * en,
+                    "pane {pane}, {backend}: {got} vs {want}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_sun_and_a_perez_sky_in_the_office_match_the_path_tracer() {
+    // A clear spring noon (the sun by the SPA at 37° altitude, through the glazed south
+    // window onto the floor): the meshless image on both backends against the path tracer,
+    // over 4 × 4 blocks within 2% and in the mean within 1%.
+    let scene = office("sun.toml", 96, 72);
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    let paths = PathOptions {
+        spp: 1024,
+        ..PathOptions::default()
+    };
+    let reference = path_trace(&scene, vis.as_ref(), &paths, &mut |_| Control::Continue)
+        .unwrap()
+        .image;
+    for backend in Backend::available() {
+        let vis = backend.build(&scene).unwrap();
+        let s = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |_| {
+            Control::Continue
+        })
+        .unwrap();
+        let image = meshlight::render(
+            &scene,
+            &s,
+            vis.as_ref(),
+            &RenderOptions::default(),
+            &mut |_| Control::Continue,
+        )
+        .unwrap()
+        .0;
+        let e = compare_blocks(&image, &reference, 4).unwrap();
+        println!(
+            "sun {backend}: {:.4} over blocks, bias {:+.4}",
+            e.mae_over_mean, e.bias
+        );
+        assert!(e.mae_over_mean < 0.02, "{backend}: {}", e.mae_over_mean);
+        assert!(e.bias.abs() < 0.01, "{backend}: bias {}", e.bias);
+    }
+}
+
 /// The shipped office (or its open variant) at `width` × `height`.
 fn office(file: &str, width: u32, height: u32) -> Scene {
     let path = common::shipped("office").with_file_name(file);

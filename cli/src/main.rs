@@ -133,7 +133,31 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
             scale::run(&scene, vis.as_ref(), &options, &epsilon, flat_limit)
         }
         Command::Info { scene } => {
-            print!("{}", info(&load(&scene, loading)?));
+            let scene = load(&scene, loading)?;
+            print!("{}", info(&scene));
+            // What sky each grid sees, where daylight enters (a ray caster is needed).
+            if scene.daylight().is_some() && !scene.grids().is_empty() {
+                let vis = meshlight::Backend::default_backend().build(&scene)?;
+                for grid in scene.grids() {
+                    let v = meshlight::daylight::sky_view(&scene, vis.as_ref(), grid)?;
+                    let said = if v.sees_sky() {
+                        format!(
+                            "sees {:.2}% of its hemisphere as sky ({:.2}% through openings, \
+                             {:.2}% through glass), {:.2}% as the ground outside",
+                            100.0 * (v.open + v.glazed),
+                            100.0 * v.open,
+                            100.0 * v.glazed,
+                            100.0 * v.ground
+                        )
+                    } else {
+                        "sees no sky: no opening or glass lets daylight reach it (is the model \
+                         closed, its glass facing inward, or [site] north or up pointing \
+                         elsewhere?)"
+                            .to_string()
+                    };
+                    println!("grid '{}'    {said}", grid.name());
+                }
+            }
             Ok(())
         }
         Command::BenchVis(bench) => bench_vis(bench, loading),

@@ -961,3 +961,59 @@ fn a_run_whose_stderr_is_a_log_prints_plain_progress_lines_unless_quiet() {
         text(&quiet.stderr)
     );
 }
+
+#[test]
+fn daylight_scenes_report_their_sky_and_a_closed_one_says_it_sees_none() {
+    // The office: info names the sky and what the work plane sees; lux its daylight factor
+    // and target.
+    let out = succeed(&["info", "scenes/office/scene.toml"]);
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("sky           CIE overcast, 10000 lx"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("grid 'work plane'    sees 5."), "{stdout}");
+    let out = succeed(&["info", "scenes/office/sun.toml"]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("sun:          altitude 37.0"), "{stdout}");
+    let dir = tempfile::tempdir().unwrap();
+    let out = succeed(&[
+        "lux",
+        "scenes/office/scene.toml",
+        "--quiet",
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("grid 'work plane': daylight factor min"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("DF average"), "{stdout}");
+    // A closed cube under a sky: no opening, no glass.
+    let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+               f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n";
+    std::fs::write(dir.path().join("cube.obj"), obj).unwrap();
+    let toml = "obj = \"cube.obj\"\ntwo_sided = true\n[camera]\nposition = [0.5, 0.5, 0.5]\n\
+                look_at = [0.5, 0.5, 1.0]\nfov_y = 60.0\nwidth = 8\nheight = 8\n[sky]\n\
+                model = \"uniform\"\n[[grid]]\nname = \"floor\"\norigin = [0.1, 0.2, 0.1]\n\
+                u = [0.8, 0, 0]\nv = [0, 0, 0.8]\nnormal = [0, 1, 0]\nspacing = 0.4\n";
+    let scene = dir.path().join("closed.toml");
+    std::fs::write(&scene, toml).unwrap();
+    let out = succeed(&["info", scene.to_str().unwrap()]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("grid 'floor'    sees no sky"), "{stdout}");
+    let out = succeed(&[
+        "lux",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("grid 'floor': no daylight reaches it"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("daylight factor min 0.00%"), "{stdout}");
+}

@@ -7,7 +7,9 @@ mod site;
 pub mod sky;
 pub mod spa;
 mod spa_tables;
+mod view;
 
-pub use site::Daylight;
+pub use site::{Daylight, SUN_RADIUS_DEGREES};
 pub use sky::{Sky, SkyModel};
 pub use spa::{sun_position, LocalTime, Observer, SunPosition};
+pub use view::{sky_view, SkyView};

@@ -20,14 +20,19 @@ pub struct Daylight {
     ground: f64,
     /// The sun's zenith angle and azimuth (degrees), where the sky has one.
     sun: Option<(f64, f64)>,
+    /// The sun's illuminance on a plane facing it (0: no sunlight).
+    direct_normal: f64,
 }
+
+/// The sun's apparent radius seen from the Earth: half of 0.533°.
+pub const SUN_RADIUS_DEGREES: f64 = 0.2665;
 
 impl Daylight {
     /// Daylight from `sky` over a site whose zenith is `up` and whose north is `north` (scene
-    /// directions; north need not be horizontal: its horizontal part is taken), with the
-    /// ground below the horizon reflecting `ground_reflectance` of the sky's light (and the
-    /// sun's, `direct_horizontal`, its direct normal illuminance times the sine of its
-    /// altitude).
+    /// directions; north need not be horizontal: its horizontal part is taken), with the sun at
+    /// `sun` (zenith angle and azimuth, degrees) delivering `direct_normal` on a plane facing
+    /// it, and the ground below the horizon reflecting `ground_reflectance` of the sky's and
+    /// the sun's light on the horizontal.
     pub fn new(
         sky: Sky,
         up: Vec3,
@@ -35,7 +40,7 @@ impl Daylight {
         ground_reflectance: f64,
         diffuse_horizontal: f64,
         sun: Option<(f64, f64)>,
-        direct_horizontal: f64,
+        direct_normal: f64,
     ) -> Result<Daylight> {
         let bad = |problem: String| {
             Err(Error::Option {
@@ -63,11 +68,21 @@ impl Daylight {
         }
         if !(diffuse_horizontal.is_finite()
             && diffuse_horizontal >= 0.0
-            && direct_horizontal.is_finite()
-            && direct_horizontal >= 0.0)
+            && direct_normal.is_finite()
+            && direct_normal >= 0.0)
         {
             return bad("the sky's and the sun's illuminance must be finite and ≥ 0".into());
         }
+        if let Some((zenith, azimuth)) = sun {
+            if !(zenith.is_finite() && azimuth.is_finite()) {
+                return bad("the sun's position is not finite".into());
+            }
+        }
+        if direct_normal > 0.0 && sun.is_none() {
+            return bad("direct_normal > 0 needs the sun's position".into());
+        }
+        let direct_horizontal =
+            sun.map_or(0.0, |(z, _)| direct_normal * z.to_radians().cos().max(0.0));
         let north = horizontal.normalize();
         Ok(Daylight {
             up,
@@ -78,7 +93,16 @@ impl Daylight {
             ground: ground_reflectance * (diffuse_horizontal + direct_horizontal)
                 / std::f64::consts::PI,
             sun,
+            direct_normal,
         })
+    }
+
+    /// The sun as a light: the unit scene direction towards its centre and its illuminance on
+    /// a plane facing it; `None` when it is below the horizon or sends nothing.
+    pub fn sun_light(&self) -> Option<(Vec3, f64)> {
+        let (zenith, azimuth) = self.sun?;
+        (zenith < 90.0 && self.direct_normal > 0.0)
+            .then(|| (self.direction(zenith, azimuth), self.direct_normal))
     }
 
     /// The sky.

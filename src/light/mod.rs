@@ -21,7 +21,7 @@ use crate::scene::{PointSource, Scene};
 use crate::specular::images::{self, Chain};
 use crate::specular::shadow::{self, LightPath};
 use crate::specular::Specular;
-use crate::visibility::{Segment, Visibility};
+use crate::visibility::{Ray, Segment, Visibility};
 
 pub(crate) mod leaving;
 mod spherical;
@@ -111,6 +111,40 @@ pub struct DirectLight {
     images: Vec<Vec<Emitter>>,
     /// Whether the lights are reached straight too (not only through mirrors).
     straight: bool,
+    /// The sun, where daylight with sunlight enters the scene.
+    sun: Option<Sun>,
+}
+
+/// The sun as a light: a disc of 0.533° delivering `illuminance` on a plane facing it.
+#[derive(Clone, Copy, Debug)]
+struct Sun {
+    /// Unit direction towards its centre.
+    dir: Vec3,
+    illuminance: f64,
+    /// Two unit directions across the disc.
+    across: (Vec3, Vec3),
+    /// How far a ray is followed to leave the scene.
+    far: f32,
+}
+
+impl Sun {
+    /// The most shadow rays a receiver sends to the sun: its disc is small, so its penumbrae
+    /// are narrow and a few stratified rays draw them.
+    const RAYS: u32 = 16;
+
+    /// Direction `s` of `count` over the disc (uniform in solid angle, on a Fibonacci lattice
+    /// shifted by `shift`).
+    fn ray(&self, s: u32, count: u32, shift: (f64, f64)) -> Vec3 {
+        let (u1, u2) = lattice(s, count, shift);
+        let cos_max = crate::daylight::SUN_RADIUS_DEGREES.to_radians().cos();
+        let cos = 1.0 - u1 * (1.0 - cos_max);
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let phi = std::f64::consts::TAU * u2;
+        (self.dir * cos as f32
+            + self.across.0 * (sin * phi.cos()) as f32
+            + self.across.1 * (sin * phi.sin()) as f32)
+            .normalize()
+    }
 }
 
 /// Which ways to the lights a [`DirectLight`] takes.
@@ -176,6 +210,15 @@ impl DirectLight {
             })
             .collect();
         let points = scene.point_sources();
+        let sun = scene
+            .daylight()
+            .and_then(crate::daylight::Daylight::sun_light)
+            .map(|(dir, illuminance)| Sun {
+                dir,
+                illuminance,
+                across: dir.any_orthonormal_pair(),
+                far: 2.0 * scene.bounds.diagonal() + 1.0,
+            });
         DirectLight {
             emitters,
             points,
@@ -184,6 +227,7 @@ impl DirectLight {
             specular: None,
             images: Vec::new(),
             straight: true,
+            sun,
         }
     }
 
@@ -287,7 +331,14 @@ impl DirectLight {
 
     /// Shadow rays one receiver may cast (for progress and query counts).
     pub fn rays_per_receiver(&self) -> usize {
-        self.points.len() + self.emitters.len() * self.light_samples as usize
+        self.points.len()
+            + self.emitters.len() * self.light_samples as usize
+            + self.sun.map_or(0, |_| self.sun_rays() as usize)
+    }
+
+    /// Shadow rays per receiver to the sun.
+    fn sun_rays(&self) -> u32 {
+        self.light_samples.min(Sun::RAYS)
     }
 
     /// Direct light at each (position, normal); receiver i draws its shadow rays from a seed
@@ -363,6 +414,7 @@ impl DirectLight {
             &mut unoccluded,
             &mut dark_emitters,
         )?;
+        let sun_queries = self.sun_at(vis, (points, ids, seed), &mut arrived, &mut unoccluded)?;
         for (r, o) in out.iter_mut().enumerate() {
             let (h, full) = (arrived[r], unoccluded[r]);
             *o = Arrival {
@@ -375,7 +427,82 @@ impl DirectLight {
                 dark_emitters: dark_emitters[r],
             };
         }
-        Ok(point_queries + area_queries)
+        Ok(point_queries + area_queries + sun_queries)
+    }
+
+    /// The sun: its illuminance × cos θ × the share of stratified shadow rays over its disc
+    /// that leave the model (through glass with its transmittance), straight only. Adds to
+    /// `arrived` and `unoccluded`; returns the queries.
+    fn sun_at(
+        &self,
+        vis: &dyn Visibility,
+        (points, ids, seed): (&[(Vec3, Vec3)], &[u32], u64),
+        arrived: &mut [DVec3],
+        unoccluded: &mut [f64],
+    ) -> Result<u64> {
+        let Some(sun) = self.sun.filter(|_| self.straight) else {
+            return Ok(0);
+        };
+        let count = self.sun_rays();
+        let mut lit = Vec::new();
+        let mut rays = Vec::new();
+        for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
+            let cos = f64::from(n.dot(sun.dir));
+            if cos <= 0.0 {
+                continue;
+            }
+            let full = sun.illuminance * cos;
+            unoccluded[r] += 3.0 * full;
+            let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 5));
+            let shift = (rng.random::<f64>(), rng.random::<f64>());
+            let from = x + self.lift * n;
+            for s in 0..count {
+                let dir = sun.ray(s, count, shift);
+                // Each ray carries its own cosine: a receiver the disc's edge grazes.
+                let c = f64::from(n.dot(dir)).max(0.0);
+                rays.push(Ray {
+                    origin: from,
+                    dir,
+                    t_min: 0.0,
+                    t_max: sun.far,
+                });
+                lit.push((r, sun.illuminance * c / f64::from(count)));
+            }
+        }
+        if rays.is_empty() {
+            return Ok(0);
+        }
+        let mut shares = vec![DVec3::ZERO; rays.len()];
+        match &self.specular {
+            Some((spec, _)) => {
+                let paths: Vec<LightPath> = rays
+                    .iter()
+                    .map(|ray| LightPath {
+                        from: ray.origin,
+                        to: ray.origin + ray.dir * sun.far,
+                        chain: STRAIGHT,
+                    })
+                    .collect();
+                shadow::arriving(spec, vis, self.lift, &paths, &mut shares)?;
+            }
+            None => {
+                // Rays, not segments: a segment out of the scene ignores hits within 10⁻⁵ of
+                // its length of its start, nearer than a corner's sample to the next wall.
+                let mut hits = vec![None; rays.len()];
+                vis.intersect(&rays, &mut hits)?;
+                for (share, hit) in shares.iter_mut().zip(hits) {
+                    *share = if hit.is_some() {
+                        DVec3::ZERO
+                    } else {
+                        DVec3::ONE
+                    };
+                }
+            }
+        }
+        for (&(r, e), share) in lit.iter().zip(&shares) {
+            arrived[r] += *share * e;
+        }
+        Ok(rays.len() as u64)
     }
 
     /// Point lights: I·cosθ/r² through one shadow ray each, and from each mirror image with

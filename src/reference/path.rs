@@ -647,6 +647,27 @@ impl Tracer<'_> {
                 self.connect(index, from, light.position, contribution, queue);
             }
         }
+        if let Some((towards, illuminance)) = scene.daylight().and_then(|d| d.sun_light()) {
+            // The sun: one direction uniform over its disc (L Ω = E_n, so the estimate is
+            // f E_n cos θ), followed out of the model.
+            let cos_max = crate::daylight::SUN_RADIUS_DEGREES.to_radians().cos();
+            let (u1, u2): (f64, f64) = (path.rng.random(), path.rng.random());
+            let c = 1.0 - u1 * (1.0 - cos_max);
+            let s = (1.0 - c * c).max(0.0).sqrt();
+            let (a, b) = towards.any_orthonormal_pair();
+            let phi = std::f64::consts::TAU * u2;
+            let w = (towards * c as f32 + a * (s * phi.cos()) as f32 + b * (s * phi.sin()) as f32)
+                .normalize();
+            let cos = f64::from(n.dot(w));
+            if cos > 0.0 {
+                let contribution = match &smooth.lobe {
+                    None => smooth.reflect * illuminance * cos,
+                    Some(_) => smooth.value(w.as_dvec3(), cos) * illuminance,
+                };
+                let far = 2.0 * scene.bounds().diagonal() + 1.0;
+                self.connect(index, from, from + w * far, contribution, queue);
+            }
+        }
         let u: f64 = path.rng.random();
         let (r1, r2): (f32, f32) = (path.rng.random(), path.rng.random());
         let mut area = None;

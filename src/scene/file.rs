@@ -678,14 +678,6 @@ fn daylight(
             }
         )));
     }
-    let up_sun = sun.filter(|&(zenith, _)| zenith < 90.0);
-    if direct > 0.0 && up_sun.is_some() {
-        return Err(fail(
-            "direct_normal > 0: the sun's own light is not lit yet in this version (the sky is); \
-             set direct_normal = 0 to light the scene by the sky alone"
-                .into(),
-        ));
-    }
     let (zenith, azimuth) = sun.unwrap_or((0.0, 0.0));
     let model = match model {
         SkyModel::Perez { .. } => {
@@ -699,7 +691,6 @@ fn daylight(
         m => m,
     };
     let sky = Sky::new(model, zenith, azimuth, diffuse).map_err(|e| fail(e.to_string()))?;
-    let direct_horizontal = up_sun.map_or(0.0, |(z, _)| direct * z.to_radians().cos());
     let up = s.up.map_or(Vec3::Y, Vec3::from);
     let north = s.north.map_or(-Vec3::Z, Vec3::from);
     Daylight::new(
@@ -709,7 +700,7 @@ fn daylight(
         s.ground_reflectance.unwrap_or(0.2),
         diffuse,
         sun,
-        direct_horizontal,
+        direct,
     )
     .map(Some)
     .map_err(|e| site_fail(e.to_string()))

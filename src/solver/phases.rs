@@ -265,7 +265,8 @@ impl Solve<'_> {
     /// scene closed around its area lights and without specular surfaces (`balance`); 1
     /// elsewhere. From the first samples' `arrivals`; later rounds' samples take it too.
     fn balance(&self, solution: &Solution, arrivals: &[Arrival]) -> Result<DVec3> {
-        if self.specular.is_some() || self.reporter.stopped() {
+        // Daylight is not the lights' power: a scene it enters is not closed around them.
+        if self.specular.is_some() || self.reporter.stopped() || self.scene.daylight().is_some() {
             return Ok(DVec3::ONE);
         }
         let settings = (self.options.seed, self.options.threads.max(1));
