@@ -140,6 +140,15 @@ fn portals(scene: &Scene) -> Vec<Portal> {
     out
 }
 
+/// Point `s` of a Fibonacci lattice of `count` in the unit square, shifted by `shift`
+/// (Cranley–Patterson).
+fn lattice(s: usize, count: usize, shift: (f64, f64)) -> (f64, f64) {
+    const GOLDEN: f64 = 0.618_033_988_749_894_8;
+    let u1 = ((s as f64 + 0.5) / count as f64 + shift.0).fract();
+    let u2 = (s as f64 * GOLDEN + shift.1).fract();
+    (u1, u2)
+}
+
 /// Where a ray from `origin` along unit `dir` crosses a triangle, if it does (t > 0).
 fn crossing(origin: Vec3, dir: Vec3, [a, b, c]: [Vec3; 3]) -> Option<f32> {
     let (e1, e2) = (b - a, c - a);
@@ -225,18 +234,27 @@ impl<'a> Entering<'a> {
             };
             let spread = n_rays - aimed;
             let (t, b) = n.any_orthonormal_pair();
+            // Both ways draw from Fibonacci lattices shifted at random per receiver (as even
+            // as a grid for any count, and unbiased): the portals' rays spread over the
+            // portals in proportion and over each portal's area, the rest over the
+            // hemisphere.
+            let shift = (rng.random::<f64>(), rng.random::<f64>());
             for i in 0..n_rays {
                 let dir = if i < aimed {
-                    let pick = rng.random::<f64>() * total;
+                    let (u1, u2) = lattice(i, aimed, shift);
+                    let pick = u1 * total;
                     let j = solid.partition_point(|&c| c <= pick).min(solid.len() - 1);
+                    // Where in its share of the line the pick fell: the point's first
+                    // coordinate, so the portal's rays stay stratified over it.
+                    let below = if j == 0 { 0.0 } else { solid[j - 1] };
+                    let within = ((pick - below) / (solid[j] - below)).clamp(0.0, 1.0);
                     let p = &self.portals[j];
-                    let at = crate::light::in_triangle(p.vertices, rng.random(), rng.random());
+                    let at = crate::light::in_triangle(p.vertices, within, u2);
                     (at - from).normalize_or_zero()
                 } else {
-                    // Cosine-weighted, stratified over the receiver's hemisphere.
-                    let k = i - aimed;
-                    let u = (k as f64 + rng.random::<f64>()) / spread as f64;
-                    let phi = std::f64::consts::TAU * rng.random::<f64>();
+                    // Cosine-weighted over the receiver's hemisphere.
+                    let (u, v) = lattice(i - aimed, spread, shift);
+                    let phi = std::f64::consts::TAU * v;
                     let r = u.sqrt();
                     (t * (r * phi.cos()) as f32
                         + b * (r * phi.sin()) as f32
