@@ -70,6 +70,9 @@ pub struct Measured {
     pub target_em: Option<f64>,
     pub target_u0: Option<f64>,
     pub verdict: Option<String>,
+    /// Under an overcast or uniform sky: its daylight factor and its targets' verdicts (and a
+    /// warning where no daylight reaches it).
+    pub daylight: Vec<String>,
     /// The CSV and the plan written.
     pub csv: std::path::PathBuf,
     pub png: std::path::PathBuf,
@@ -183,7 +186,8 @@ pub fn measure(
         if let Some(verdict) = &verdict {
             println!("grid '{}': {verdict}", grid.name());
         }
-        for said in daylight_factor(scene, grid, &open) {
+        let daylight = daylight_factor(scene, grid, &open);
+        for said in &daylight {
             println!("grid '{}': {said}", grid.name());
         }
         println!("wrote {} and {}", csv.display(), png.display());
@@ -195,6 +199,7 @@ pub fn measure(
             target_em: grid.target_em(),
             target_u0: grid.target_u0(),
             verdict,
+            daylight,
             csv,
             png,
         });

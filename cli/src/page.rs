@@ -175,6 +175,28 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
             .join(", ")
     )?;
 
+    // Daylight factor, where the sky is overcast or uniform.
+    if grids.iter().any(|g| !g.daylight.is_empty()) {
+        writeln!(h, "<section id=\"daylight\"><h2>Daylight factor</h2><ul>")?;
+        for g in grids {
+            for said in &g.daylight {
+                let class = if said.contains("NOT met") || said.starts_with("no daylight") {
+                    " class=\"fail\""
+                } else if said.contains(": met") {
+                    " class=\"pass\""
+                } else {
+                    ""
+                };
+                writeln!(h, "<li{class}>{}: {}</li>", escape(&g.name), escape(said))?;
+            }
+        }
+        writeln!(
+            h,
+            "</ul><p>DF = E / E<sub>h</sub>, E<sub>h</sub> the sky's illuminance on an \
+             unobstructed horizontal plane.</p></section>"
+        )?;
+    }
+
     // Plans.
     writeln!(h, "<section id=\"plans\"><h2>Isolux plans</h2>")?;
     for g in grids {

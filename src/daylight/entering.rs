@@ -29,8 +29,8 @@ use crate::specular::Specular;
 use crate::visibility::{Ray, Visibility};
 
 /// Portal triangles a scene may have before they cost more than they save (every receiver
-/// weighs each one, and every ray is tested against each one): beyond, rays go over the
-/// hemisphere only.
+/// weighs each one, and every ray is tested against each one): beyond, the holes' are dropped
+/// (the panes' kept if they fit), and rays go over the hemisphere only where none are left.
 const MAX_PORTALS: usize = 512;
 
 /// The share of a receiver's rays aimed at the portals (where it has any in front).
@@ -62,8 +62,7 @@ pub(crate) struct Entering<'a> {
 
 /// The portal triangles of a scene: its thin panes and its holes.
 fn portals(scene: &Scene) -> Vec<Portal> {
-    let mut out = Vec::new();
-    let mut push = |vertices: [Vec3; 3]| {
+    fn push(out: &mut Vec<Portal>, vertices: [Vec3; 3]) {
         let e = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
         let area = 0.5 * e.length();
         if area > 0.0 && area.is_finite() {
@@ -74,15 +73,17 @@ fn portals(scene: &Scene) -> Vec<Portal> {
                 centroid: (vertices[0] + vertices[1] + vertices[2]) / 3.0,
             });
         }
-    };
+    }
+    let mut out = Vec::new();
     for t in &scene.triangles {
         if matches!(
             scene.material_of(t.surface).kind,
             Kind::Glass { thin: true, .. }
         ) {
-            push(t.vertices);
+            push(&mut out, t.vertices);
         }
     }
+    let panes = out.len();
     // Edges used by one triangle only (corners compared by their bits).
     let key = |v: Vec3| (v + Vec3::ZERO).to_array().map(f32::to_bits);
     let mut uses: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::new();
@@ -134,8 +135,20 @@ fn portals(scene: &Scene) -> Vec<Portal> {
         let points: Vec<Vec3> = ring.iter().map(|k| position[k]).collect();
         let centroid = points.iter().sum::<Vec3>() / points.len() as f32;
         for i in 0..points.len() {
-            push([centroid, points[i], points[(i + 1) % points.len()]]);
+            push(
+                &mut out,
+                [centroid, points[i], points[(i + 1) % points.len()]],
+            );
         }
+    }
+    // A mesh full of T-junctions (tiled walls under one large ceiling quad, say) has "holes"
+    // everywhere: then the loops are dropped and only the panes kept; past the bound even
+    // they are (the hemisphere's rays still find every way out).
+    if out.len() > MAX_PORTALS {
+        out.truncate(panes);
+    }
+    if out.len() > MAX_PORTALS {
+        out.clear();
     }
     out
 }
@@ -177,10 +190,7 @@ impl<'a> Entering<'a> {
     /// daylight.
     pub(crate) fn of(scene: &'a Scene, rays: u32) -> Option<Entering<'a>> {
         let daylight = scene.daylight.as_ref()?;
-        let mut portals = portals(scene);
-        if portals.len() > MAX_PORTALS {
-            portals.clear();
-        }
+        let portals = portals(scene);
         let specular = Some(Specular::of(scene)).filter(Specular::any);
         Some(Entering {
             daylight,
@@ -355,6 +365,60 @@ impl<'a> Entering<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A unit box without its top (+y) face, faces inward, corners shared between faces by
+    /// position only (each face its own four vertices, as OBJ exporters write them).
+    fn open_box() -> Scene {
+        use crate::scene::{Camera, Material, Mesh, SceneParts, SolverDefaults};
+        let v = Vec3::new;
+        let faces = [
+            [v(0., 0., 0.), v(0., 0., 1.), v(1., 0., 1.), v(1., 0., 0.)],
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)],
+            [v(0., 0., 1.), v(0., 1., 1.), v(1., 1., 1.), v(1., 0., 1.)],
+            [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)],
+            [v(1., 0., 0.), v(1., 0., 1.), v(1., 1., 1.), v(1., 1., 0.)],
+        ];
+        let mut mesh = Mesh {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            triangle_materials: Vec::new(),
+            materials: vec![Material::diffuse("w", Vec3::splat(0.5), Vec3::ZERO)],
+            texcoords: Vec::new(),
+        };
+        for f in faces {
+            let base = mesh.positions.len() as u32;
+            mesh.positions.extend(f);
+            mesh.triangles
+                .extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+            mesh.triangle_materials.extend([0, 0]);
+        }
+        let parts = SceneParts {
+            mesh,
+            point_lights: Vec::new(),
+            camera: Camera {
+                position: Vec3::splat(0.5),
+                look_at: v(0.5, 0.0, 0.5),
+                up: Vec3::Z,
+                fov_y: 60.0,
+                width: 4,
+                height: 4,
+            },
+            two_sided: false,
+            solver: SolverDefaults::default(),
+        };
+        Scene::from_parts("open box", parts).unwrap()
+    }
+
+    #[test]
+    fn the_hole_of_an_open_box_is_its_portal() {
+        // The missing top: one loop of four edges, fanned into four triangles of area 1/4
+        // at height 1.
+        let found = portals(&open_box());
+        assert_eq!(found.len(), 4, "{found:?}");
+        let area: f32 = found.iter().map(|p| p.area).sum();
+        assert!((area - 1.0).abs() < 1e-6, "{area}");
+        assert!(found.iter().all(|p| p.vertices.iter().all(|v| v.y == 1.0)));
+    }
 
     #[test]
     fn a_ray_crosses_a_triangle_where_it_lies() {
