@@ -22,7 +22,7 @@ use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
 
 /// Rays per grid point towards the sky and the ground, where daylight enters a scene.
-const GRID_SKY_RAYS: u32 = 1024;
+const GRID_SKY_RAYS: u32 = 4096;
 
 /// How grid points are measured.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -122,6 +122,194 @@ fn roof_light(kd: f32, pane: bool) -> Scene {
     b.scene(camera(v(2.0, 1.5, 0.5), v(2.0, 1.5, 3.0), 16))
 }
 
+/// A 4 × 3 × 4 black box (x, z in 0..4, y in 0..3) with a 1 × 1 window in its +z wall
+/// (x 1.5..2.5, y 1..2), every face on one grid of corners; with `pane`, a thin pane of index
+/// 1.52 5 cm outside the window.
+fn facade_light(pane: bool) -> Scene {
+    let mut b = Builder::default();
+    let inside = b.material(material("inside", 0.0, 0.0));
+    let glass = b.material(common::glass("pane", 1.52, true));
+    let (xs, ys, zs) = ([0.0, 1.5, 2.5, 4.0], [0.0, 1.0, 2.0, 3.0], [0.0, 4.0]);
+    let v = Vec3::new;
+    let mut face = |c: [Vec3; 4], inward: Vec3, m: u32| {
+        let n = (c[1] - c[0]).cross(c[2] - c[0]);
+        if n.dot(inward) > 0.0 {
+            b.quad(c, m);
+        } else {
+            b.quad([c[3], c[2], c[1], c[0]], m);
+        }
+    };
+    for i in 0..3 {
+        let (x0, x1) = (xs[i], xs[i + 1]);
+        let (z0, z1) = (zs[0], zs[1]);
+        face(
+            [
+                v(x0, 0.0, z0),
+                v(x1, 0.0, z0),
+                v(x1, 0.0, z1),
+                v(x0, 0.0, z1),
+            ],
+            Vec3::Y,
+            inside,
+        );
+        face(
+            [
+                v(x0, 3.0, z0),
+                v(x1, 3.0, z0),
+                v(x1, 3.0, z1),
+                v(x0, 3.0, z1),
+            ],
+            -Vec3::Y,
+            inside,
+        );
+        for j in 0..3 {
+            let (y0, y1) = (ys[j], ys[j + 1]);
+            face(
+                [
+                    v(x0, y0, 0.0),
+                    v(x1, y0, 0.0),
+                    v(x1, y1, 0.0),
+                    v(x0, y1, 0.0),
+                ],
+                Vec3::Z,
+                inside,
+            );
+            if (i, j) != (1, 1) {
+                face(
+                    [
+                        v(x0, y0, 4.0),
+                        v(x1, y0, 4.0),
+                        v(x1, y1, 4.0),
+                        v(x0, y1, 4.0),
+                    ],
+                    -Vec3::Z,
+                    inside,
+                );
+            }
+        }
+    }
+    for j in 0..3 {
+        let (y0, y1) = (ys[j], ys[j + 1]);
+        face(
+            [
+                v(0.0, y0, 0.0),
+                v(0.0, y0, 4.0),
+                v(0.0, y1, 4.0),
+                v(0.0, y1, 0.0),
+            ],
+            Vec3::X,
+            inside,
+        );
+        face(
+            [
+                v(4.0, y0, 0.0),
+                v(4.0, y0, 4.0),
+                v(4.0, y1, 4.0),
+                v(4.0, y1, 0.0),
+            ],
+            -Vec3::X,
+            inside,
+        );
+    }
+    if pane {
+        face(
+            [
+                v(1.4, 0.9, 4.05),
+                v(2.6, 0.9, 4.05),
+                v(2.6, 2.1, 4.05),
+                v(1.4, 2.1, 4.05),
+            ],
+            Vec3::Z,
+            glass,
+        );
+    }
+    b.scene(camera(v(2.0, 1.5, 0.5), v(2.0, 1.5, 3.0), 16))
+}
+
+/// The sky component at `p` (facing up) through the façade window at z = 4: ∫ L(θ) T cos θ_p
+/// dω over the window, by the midpoint rule on 400 × 400 cells (θ the element's zenith angle;
+/// the pane's angle of incidence is the one to the window's normal).
+fn facade_component(p: Vec3, luminance: impl Fn(f64) -> f64, pane: bool) -> f64 {
+    let n = 400;
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let x = 1.5 + (i as f64 + 0.5) / n as f64 - f64::from(p.x);
+            let y = 1.0 + (j as f64 + 0.5) / n as f64 - f64::from(p.y);
+            let z = 4.0 - f64::from(p.z);
+            let r2 = x * x + y * y + z * z;
+            let r = r2.sqrt();
+            let (cos_up, cos_window) = (y / r, z / r);
+            let t = if pane {
+                let reflected = fresnel(1.52, cos_window);
+                (1.0 - reflected) / (1.0 + reflected)
+            } else {
+                1.0
+            };
+            sum += luminance(cos_up) * t * cos_up * cos_window / r2;
+        }
+    }
+    sum / (n * n) as f64
+}
+
+#[test]
+fn a_point_beside_a_facade_opening_gets_the_sky_component() {
+    // Points on the floor of a black room 0.5 to 2.5 m from a 1 × 1 window whose sill is 1 m
+    // up: every ray through the window rises, so only the sky is seen. Uniform and CIE
+    // overcast, open and glazed, within 1% of the integral.
+    let uniform = |_: f64| EH / PI;
+    let lz = 9.0 * EH / (7.0 * PI);
+    let overcast = |c: f64| lz * (1.0 + 2.0 * c) / 3.0;
+    for pane in [false, true] {
+        for model in [SkyModel::Uniform, SkyModel::CieOvercast] {
+            let scene = with_sky(facade_light(pane), model);
+            let grid = Grid::new(
+                "floor",
+                Vec3::new(1.0, 0.01, 1.0),
+                Vec3::new(2.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, 2.5),
+                Some(Vec3::Y),
+                Some(1.0),
+            )
+            .unwrap();
+            for backend in Backend::available() {
+                let vis = backend.build(&scene).unwrap();
+                let options = Options {
+                    rounds: 0,
+                    ..Options::default()
+                };
+                let s =
+                    meshlight::solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue)
+                        .unwrap();
+                let e = illuminance(
+                    &scene,
+                    &s,
+                    vis.as_ref(),
+                    &grid,
+                    &LuxOptions::default(),
+                    &mut |_| Control::Continue,
+                )
+                .unwrap();
+                for (p, got) in grid.points().iter().zip(&e.values) {
+                    let expected = match model {
+                        SkyModel::Uniform => facade_component(*p, uniform, pane),
+                        _ => facade_component(*p, overcast, pane),
+                    };
+                    let error = got.x / expected - 1.0;
+                    println!(
+                        "façade {model:?} pane {pane} {backend} at {p}: {:.3} lx vs {expected:.3}",
+                        got.x
+                    );
+                    assert!(
+                        error.abs() < 0.01,
+                        "{model:?}, pane {pane}, {backend}, {p}: {error:+.4}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn with_sky(mut scene: Scene, model: SkyModel) -> Scene {
     let sky = Sky::new(model, 0.0, 0.0, EH).unwrap();
     let daylight = Daylight::new(sky, Vec3::Y, -Vec3::Z, 0.2, EH, None, 0.0).unwrap();
