@@ -73,6 +73,8 @@ pub struct Measured {
     /// Under an overcast or uniform sky: its daylight factor and its targets' verdicts (and a
     /// warning where no daylight reaches it).
     pub daylight: Vec<String>,
+    /// Its daylight-factor plan, where the sky is overcast or uniform.
+    pub df_png: Option<std::path::PathBuf>,
     /// The CSV and the plan written.
     pub csv: std::path::PathBuf,
     pub png: std::path::PathBuf,
@@ -190,6 +192,39 @@ pub fn measure(
         for said in &daylight {
             println!("grid '{}': {said}", grid.name());
         }
+        // The same plan in daylight factor, where it is defined.
+        let df_png = match df_sky(scene) {
+            Some(eh) => {
+                let df: Vec<f64> = values.iter().map(|v| 100.0 * v / eh).collect();
+                let path = dir.join(format!("{stem}-df.png"));
+                // "daylight factor min a%, average b%, median c% (E_h …)": a line each.
+                let caption: Vec<String> = daylight
+                    .iter()
+                    .filter_map(|l| l.strip_prefix("daylight factor "))
+                    .flat_map(|l| l.split(" (").next().unwrap_or("").split(", "))
+                    .map(|part| format!("DF {part}"))
+                    .collect();
+                super::plan::plan_png(
+                    &path,
+                    &Plan {
+                        counts: (nu, nv),
+                        values: &df,
+                        excluded: &inside,
+                        spacing: (
+                            f64::from(u.length()) / f64::from(nu),
+                            f64::from(v.length()) / f64::from(nv),
+                        ),
+                        marks: &[],
+                        outline: &cut(scene, grid),
+                        unit: "%",
+                        title: &format!("{} (daylight factor, %)", grid.name()),
+                        caption: &caption,
+                    },
+                )?;
+                Some(path)
+            }
+            None => None,
+        };
         println!("wrote {} and {}", csv.display(), png.display());
         measured.push(Measured {
             name: grid.name().to_string(),
@@ -200,11 +235,21 @@ pub fn measure(
             target_u0: grid.target_u0(),
             verdict,
             daylight,
+            df_png,
             csv,
             png,
         });
     }
     Ok(measured)
+}
+
+/// E_h of the scene's sky where the daylight factor is defined (an overcast or uniform sky).
+fn df_sky(scene: &Scene) -> Option<f64> {
+    use meshlight::daylight::SkyModel;
+    let d = scene.daylight()?;
+    (matches!(d.sky().model(), SkyModel::CieOvercast | SkyModel::Uniform)
+        && d.diffuse_horizontal() > 0.0)
+        .then(|| d.diffuse_horizontal())
 }
 
 /// The daylight factor DF = E / E_h of a grid under an overcast or uniform sky (min, average,

@@ -193,8 +193,22 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
         writeln!(
             h,
             "</ul><p>DF = E / E<sub>h</sub>, E<sub>h</sub> the sky's illuminance on an \
-             unobstructed horizontal plane.</p></section>"
+             unobstructed horizontal plane.</p>"
         )?;
+        for g in grids {
+            let Some(path) = &g.df_png else { continue };
+            let png =
+                std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+            writeln!(
+                h,
+                "<figure><img alt=\"daylight factor plan of {n}\" \
+                 src=\"data:image/png;base64,{}\"><figcaption>{n}: daylight factor, \
+                 iso-lines at round values (%)</figcaption></figure>",
+                base64(&png),
+                n = escape(&g.name)
+            )?;
+        }
+        writeln!(h, "</section>")?;
     }
 
     // Plans.

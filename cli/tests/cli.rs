@@ -1008,6 +1008,11 @@ fn daylight_scenes_report_their_sky_and_a_closed_one_says_it_sees_none() {
         html.contains("class=\"pass\">work plane: DF average"),
         "no verdict"
     );
+    assert!(
+        html.contains("alt=\"daylight factor plan of work plane\""),
+        "no DF plan"
+    );
+    assert!(page.join("work_plane-df.png").exists());
     // A closed cube under a sky: no opening, no glass.
     let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
                f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n";
