@@ -659,3 +659,24 @@ fn a_sky_the_file_gets_wrong_is_an_error_naming_its_line() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_skylit_gallery_sees_its_sky_through_glass_only() {
+    // Its 149k triangles meet at T-junctions everywhere (tiled walls under whole ceiling
+    // quads), so the mesh has "holes" that are not openings; the sky must still come only
+    // through the glazed skylights, and every grid must see some.
+    let path = meshlight_gallery::ensure_skylit().unwrap();
+    let scene = Scene::load(path).unwrap();
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    for grid in scene.grids() {
+        let view = meshlight::daylight::sky_view(&scene, vis.as_ref(), grid).unwrap();
+        println!("{}: {view:?}", grid.name());
+        assert_eq!(
+            view.open,
+            0.0,
+            "{}: sky seen other than through glass",
+            grid.name()
+        );
+        assert!(view.glazed > 0.01, "{}: {view:?}", grid.name());
+    }
+}

@@ -26,6 +26,9 @@ pub struct GalleryOptions {
     pub sphere_detail: u32,
     /// Rooms along x and along z (each 12 m × 8 m between partition centres).
     pub rooms: [usize; 2],
+    /// A glazed skylight 4 m × 2 m in the middle of each room's ceiling (`gallery-skylit.obj`,
+    /// lit by `daylight.toml`).
+    pub skylights: bool,
 }
 
 impl Default for GalleryOptions {
@@ -34,6 +37,7 @@ impl Default for GalleryOptions {
             tile: 0.1,
             sphere_detail: 2,
             rooms: [2, 2],
+            skylights: false,
         }
     }
 }
@@ -46,6 +50,8 @@ const HEIGHT: f64 = 4.5;
 const WALL: f64 = 0.2;
 const DOOR_WIDTH: f64 = 1.6;
 const DOOR_HEIGHT: f64 = 2.6;
+/// A skylight's opening, along x and z, metres.
+const SKYLIGHT: [f64; 2] = [4.0, 2.0];
 
 /// The grid of rooms.
 #[derive(Clone, Copy, Debug)]
@@ -421,15 +427,44 @@ fn build(options: GalleryOptions) -> Obj {
             }
         }
     }
-    // Ceiling: one large quad per room (huge triangles beside the small ones).
+    // Ceiling: one large quad per room (huge triangles beside the small ones); with skylights,
+    // four around each room's opening, and a pane over it overlapping the opening.
     for i in 0..layout.nx {
         for j in 0..layout.nz {
             let (x0, x1, z0, z1) = layout.room(i, j);
+            if !options.skylights {
+                obj.rect(
+                    "ceiling",
+                    [x0, HEIGHT, z0],
+                    [x1 - x0, 0.0, 0.0],
+                    [0.0, 0.0, z1 - z0],
+                    [0.0, -1.0, 0.0],
+                );
+                continue;
+            }
+            let (cx, cz) = (0.5 * (x0 + x1), 0.5 * (z0 + z1));
+            let (hx0, hx1) = (cx - 0.5 * SKYLIGHT[0], cx + 0.5 * SKYLIGHT[0]);
+            let (hz0, hz1) = (cz - 0.5 * SKYLIGHT[1], cz + 0.5 * SKYLIGHT[1]);
+            for (a, b, c, d) in [
+                (x0, x1, z0, hz0),
+                (x0, x1, hz1, z1),
+                (x0, hx0, hz0, hz1),
+                (hx1, x1, hz0, hz1),
+            ] {
+                obj.rect(
+                    "ceiling",
+                    [a, HEIGHT, c],
+                    [b - a, 0.0, 0.0],
+                    [0.0, 0.0, d - c],
+                    [0.0, -1.0, 0.0],
+                );
+            }
+            // 0.3 m of overlap 5 cm up: no ray from inside the room rises that flat.
             obj.rect(
-                "ceiling",
-                [x0, HEIGHT, z0],
-                [x1 - x0, 0.0, 0.0],
-                [0.0, 0.0, z1 - z0],
+                "skylight",
+                [hx0 - 0.3, HEIGHT + 0.05, hz0 - 0.3],
+                [hx1 - hx0 + 0.6, 0.0, 0.0],
+                [0.0, 0.0, hz1 - hz0 + 0.6],
                 [0.0, -1.0, 0.0],
             );
         }
@@ -615,9 +650,24 @@ pub fn header(options: GalleryOptions) -> String {
         format!(" rooms={}x{}", options.rooms[0], options.rooms[1])
     };
     format!(
-        "# meshlight gallery v1 tile={} sphere_detail={}{rooms}\n",
-        options.tile, options.sphere_detail
+        "# meshlight gallery v1 tile={} sphere_detail={}{rooms}{}\n",
+        options.tile,
+        options.sphere_detail,
+        if options.skylights {
+            " skylights=2"
+        } else {
+            ""
+        }
     )
+}
+
+/// The OBJ's file name: `gallery.obj`, or `gallery-skylit.obj` with skylights.
+pub fn obj_name(options: GalleryOptions) -> &'static str {
+    if options.skylights {
+        "gallery-skylit.obj"
+    } else {
+        "gallery.obj"
+    }
 }
 
 /// Writes `gallery.obj` into `dir` (atomically: a temporary file renamed into place, so
@@ -625,8 +675,8 @@ pub fn header(options: GalleryOptions) -> String {
 pub fn write_obj(dir: &Path, options: GalleryOptions) -> io::Result<Stats> {
     let obj = build(options);
     let text = obj.write(&header(options));
-    let path = dir.join("gallery.obj");
-    let tmp = dir.join(format!("gallery.obj.{}.tmp", std::process::id()));
+    let path = dir.join(obj_name(options));
+    let tmp = dir.join(format!("{}.{}.tmp", obj_name(options), std::process::id()));
     std::fs::write(&tmp, text)?;
     std::fs::rename(&tmp, &path)?;
     Ok(Stats {
@@ -646,6 +696,12 @@ pub fn write_scene(dir: &Path, options: GalleryOptions) -> io::Result<Stats> {
         std::fs::copy(shipped_dir().join("gallery.mtl"), dir.join("gallery.mtl"))?;
         if options.rooms == GalleryOptions::default().rooms {
             std::fs::copy(shipped_dir().join("scene.toml"), dir.join("scene.toml"))?;
+            if options.skylights {
+                std::fs::copy(
+                    shipped_dir().join("daylight.toml"),
+                    dir.join("daylight.toml"),
+                )?;
+            }
         } else {
             std::fs::write(dir.join("scene.toml"), scene_toml(options))?;
         }
@@ -661,17 +717,31 @@ pub fn shipped_dir() -> PathBuf {
 /// Makes sure the shipped gallery's OBJ exists with the default options, writing it if it is
 /// missing or stale; returns the path of `scene.toml`.
 pub fn ensure() -> io::Result<PathBuf> {
+    ensure_with(GalleryOptions::default())?;
+    Ok(shipped_dir().join("scene.toml"))
+}
+
+/// [`ensure`] for the gallery with skylights; returns the path of `daylight.toml`.
+pub fn ensure_skylit() -> io::Result<PathBuf> {
+    ensure_with(GalleryOptions {
+        skylights: true,
+        ..GalleryOptions::default()
+    })?;
+    Ok(shipped_dir().join("daylight.toml"))
+}
+
+fn ensure_with(options: GalleryOptions) -> io::Result<()> {
     let dir = shipped_dir();
-    let obj = dir.join("gallery.obj");
-    let expected = header(GalleryOptions::default());
+    let obj = dir.join(obj_name(options));
+    let expected = header(options);
     let current = std::fs::read(&obj).ok().and_then(|bytes| {
         let end = bytes.iter().position(|&b| b == b'\n')? + 1;
         String::from_utf8(bytes[..end].to_vec()).ok()
     });
     if current.as_deref() != Some(expected.as_str()) {
-        write_obj(&dir, GalleryOptions::default())?;
+        write_obj(&dir, options)?;
     }
-    Ok(dir.join("scene.toml"))
+    Ok(())
 }
 
 #[cfg(test)]

@@ -64,9 +64,10 @@ fn run() -> Result<(), String> {
                 };
             }
             "--out" => out = PathBuf::from(value("--out")?),
+            "--skylights" => options.skylights = true,
             "-h" | "--help" => {
                 println!(
-                    "usage: meshlight-gallery [--tile METRES] [--sphere-detail N] [--rooms NXxNZ] [--out DIR]"
+                    "usage: meshlight-gallery [--tile METRES] [--sphere-detail N] [--rooms NXxNZ] [--skylights] [--out DIR]"
                 );
                 return Ok(());
             }
@@ -83,7 +84,7 @@ fn run() -> Result<(), String> {
     let stats = write_scene(&out, options).map_err(|e| format!("{}: {e}", out.display()))?;
     println!(
         "wrote {} ({} vertices, {} triangles)",
-        out.join("gallery.obj").display(),
+        out.join(meshlight_gallery::obj_name(options)).display(),
         stats.vertices,
         stats.triangles
     );
