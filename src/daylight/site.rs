@@ -153,6 +153,22 @@ impl Daylight {
         let phi = d.dot(self.east).atan2(d.dot(self.north));
         self.sky.luminance(theta, phi)
     }
+
+    /// The sun's disc seen along `dir`: its luminance E_n / Ω (Ω its solid angle) inside the
+    /// disc, else 0. Only what no light sampling reaches adds it (a camera ray, a path after a
+    /// pane or a mirror): elsewhere the sun's rays count it.
+    pub fn sun_radiance(&self, dir: Vec3) -> f64 {
+        let Some((towards, illuminance)) = self.sun_light() else {
+            return 0.0;
+        };
+        let cos_max = SUN_RADIUS_DEGREES.to_radians().cos();
+        let d = dir.as_dvec3().normalize_or_zero();
+        if d.dot(towards.as_dvec3()) >= cos_max {
+            illuminance / (std::f64::consts::TAU * (1.0 - cos_max))
+        } else {
+            0.0
+        }
+    }
 }
 
 #[cfg(test)]

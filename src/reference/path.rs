@@ -543,7 +543,13 @@ impl Tracer<'_> {
             // Out of the model: the sky or the ground, found by the path's own bounce (no
             // light sampling of the sky, so no weighing).
             if let Some(daylight) = scene.daylight() {
-                path.radiance += path.throughput * daylight.radiance(path.ray.dir);
+                // The sun's disc only where nothing sampled it: camera rays and delta paths.
+                let sun = if path.bounce_pdf > 0.0 {
+                    0.0
+                } else {
+                    daylight.sun_radiance(path.ray.dir)
+                };
+                path.radiance += path.throughput * (daylight.radiance(path.ray.dir) + sun);
             }
             return false;
         };

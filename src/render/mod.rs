@@ -713,10 +713,9 @@ impl<'a> Shader<'a> {
         for (ray, hit) in rays.iter().zip(&hits) {
             let Some(Hit { t, triangle }) = *hit else {
                 // Out of the model: the sky or the ground (black without daylight).
-                let outside = self
-                    .scene
-                    .daylight()
-                    .map_or(0.0, |d| d.radiance(ray.dir) as f32);
+                let outside = self.scene.daylight().map_or(0.0, |d| {
+                    (d.radiance(ray.dir) + d.sun_radiance(ray.dir)) as f32
+                });
                 pending.push(Pending {
                     side: u32::MAX,
                     fixed: Some(Vec3::splat(outside)),

@@ -108,7 +108,14 @@ impl Shader<'_> {
                     // Out of the model (through a pane, by a mirror): the sky or the ground.
                     if let Some(d) = self.scene.daylight() {
                         if self.quantity == Quantity::Radiance {
-                            radiance[b.origin] += b.weight * d.radiance(b.ray.dir);
+                            // The sun's disc only along delta paths: a glossy lobe's rays are
+                            // not weighed against the sun's.
+                            let sun = if b.lobe_pdf.is_none() {
+                                d.sun_radiance(b.ray.dir)
+                            } else {
+                                0.0
+                            };
+                            radiance[b.origin] += b.weight * (d.radiance(b.ray.dir) + sun);
                         }
                     }
                     continue;
