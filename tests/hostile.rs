@@ -520,6 +520,77 @@ fn an_epsilon_beyond_the_scene_is_refused_by_name() {
     });
 }
 
+#[test]
+fn a_hosts_sky_out_of_range_is_refused_by_name() {
+    isolated("a_hosts_sky_out_of_range_is_refused_by_name", || {
+        use meshlight::daylight::{Daylight, Sky, SkyModel};
+        for e in [f64::NAN, -1.0, f64::INFINITY, 1e300] {
+            refused(
+                "sky",
+                Sky::new(SkyModel::CieOvercast, 0.0, 0.0, e),
+                &["diffuse_horizontal"],
+            );
+        }
+        refused(
+            "type 0",
+            Sky::new(SkyModel::Cie(0), 30.0, 180.0, 1e4),
+            &["type 0"],
+        );
+        refused(
+            "perez NaN",
+            Sky::new(
+                SkyModel::Perez {
+                    clearness: f64::NAN,
+                    brightness: 0.2,
+                },
+                30.0,
+                180.0,
+                1e4,
+            ),
+            &["Perez"],
+        );
+        let sky = || Sky::new(SkyModel::Uniform, 0.0, 0.0, 1e4).unwrap();
+        let site = |up: Vec3, north: Vec3, rho: f64, sun: Option<(f64, f64)>, en: f64| {
+            Daylight::new(sky(), up, north, rho, 1e4, sun, en)
+        };
+        refused("up 0", site(Vec3::ZERO, -Vec3::Z, 0.2, None, 0.0), &["up"]);
+        refused("up NaN", site(Vec3::NAN, -Vec3::Z, 0.2, None, 0.0), &["up"]);
+        refused(
+            "north up",
+            site(Vec3::Y, Vec3::Y, 0.2, None, 0.0),
+            &["north"],
+        );
+        refused(
+            "rho 2",
+            site(Vec3::Y, -Vec3::Z, 2.0, None, 0.0),
+            &["ground_reflectance"],
+        );
+        refused(
+            "sun NaN",
+            site(Vec3::Y, -Vec3::Z, 0.2, Some((f64::NAN, 0.0)), 1.0),
+            &["sun"],
+        );
+        refused(
+            "no sun",
+            site(Vec3::Y, -Vec3::Z, 0.2, None, 5e4),
+            &["sun's position"],
+        );
+        refused(
+            "huge sun",
+            site(Vec3::Y, -Vec3::Z, 0.2, Some((30.0, 0.0)), 1e300),
+            &["illuminance"],
+        );
+        // Within range: a scene with it solves to finite light.
+        let mut scene = room();
+        scene.set_daylight(Some(
+            site(Vec3::Y, -Vec3::Z, 1.0, Some((10.0, 0.0)), 1e6).unwrap(),
+        ));
+        let vis = Backend::Bvh.build(&scene).unwrap();
+        let s = meshlight::solve(&scene, vis.as_ref(), &quick(), &mut go).unwrap();
+        assert!(s.radiosity().iter().all(|b| b.is_finite()));
+    });
+}
+
 /// A backend that panics on its first call.
 struct Panicky;
 

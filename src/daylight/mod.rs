@@ -9,7 +9,17 @@ pub mod spa;
 mod spa_tables;
 mod view;
 
-pub use site::{Daylight, SUN_RADIUS_DEGREES};
+pub use site::{Daylight, MAX_ILLUMINANCE, SUN_RADIUS_DEGREES};
 pub use sky::{Sky, SkyModel};
 pub use spa::{sun_position, LocalTime, Observer, SunPosition};
 pub use view::{sky_view, SkyView};
+
+/// A number for messages: as Rust prints it between 0.001 and a million, in scientific
+/// notation outside.
+pub(crate) fn human(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

@@ -24,6 +24,10 @@ pub struct Daylight {
     direct_normal: f64,
 }
 
+/// The largest sky or sun illuminance a site takes: ten times the brightest the Earth sees,
+/// so a unit slip (W/m² for lx, say) passes but an overflow does not.
+pub const MAX_ILLUMINANCE: f64 = 1e6;
+
 /// The sun's apparent radius seen from the Earth: half of 0.533°.
 pub const SUN_RADIUS_DEGREES: f64 = 0.2665;
 
@@ -66,12 +70,15 @@ impl Daylight {
                 "ground_reflectance {ground_reflectance} is not within 0 to 1"
             ));
         }
-        if !(diffuse_horizontal.is_finite()
-            && diffuse_horizontal >= 0.0
-            && direct_normal.is_finite()
-            && direct_normal >= 0.0)
+        if !((0.0..=MAX_ILLUMINANCE).contains(&diffuse_horizontal)
+            && (0.0..=MAX_ILLUMINANCE).contains(&direct_normal))
         {
-            return bad("the sky's and the sun's illuminance must be finite and ≥ 0".into());
+            return bad(format!(
+                "the sky's and the sun's illuminance ({}, {}) must lie in 0 to \
+                 {MAX_ILLUMINANCE:e} (the sun at noon gives about 1.3e5 lx)",
+                super::human(diffuse_horizontal),
+                super::human(direct_normal)
+            ));
         }
         if let Some((zenith, azimuth)) = sun {
             if !(zenith.is_finite() && azimuth.is_finite()) {

@@ -275,9 +275,11 @@ impl Sky {
                 problem,
             })
         };
-        if !(diffuse_horizontal.is_finite() && diffuse_horizontal >= 0.0) {
+        if !(0.0..=super::site::MAX_ILLUMINANCE).contains(&diffuse_horizontal) {
             return bad(format!(
-                "diffuse_horizontal {diffuse_horizontal} is not a finite illuminance ≥ 0"
+                "diffuse_horizontal {} is not an illuminance in 0 to {:e}",
+                super::human(diffuse_horizontal),
+                super::site::MAX_ILLUMINANCE
             ));
         }
         if !(sun_zenith.is_finite() && sun_azimuth.is_finite()) {
