@@ -680,3 +680,21 @@ fn the_skylit_gallery_sees_its_sky_through_glass_only() {
         assert!(view.glazed > 0.01, "{}: {view:?}", grid.name());
     }
 }
+
+#[test]
+fn the_patch_baseline_refuses_a_daylit_scene() {
+    // It has no sky: a daylit room would come out dark without a word.
+    let scene = with_sky(roof_light(0.5, false), SkyModel::CieOvercast);
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    let options = meshlight::reference::PatchOptions {
+        patch_size: 0.5,
+        ..Default::default()
+    };
+    let e = meshlight::reference::patch_radiosity(&scene, vis.as_ref(), &options, &mut |_| {
+        Control::Continue
+    })
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("[sky]"), "{e}");
+}

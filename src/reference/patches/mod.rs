@@ -175,6 +175,15 @@ pub fn patch_radiosity(
 
 /// The options and the scene's camera checked, and the patch count bounded before meshing.
 fn check(scene: &Scene, options: &PatchOptions) -> Result<()> {
+    // Nor does it let daylight in: a daylit scene would come out dark without a word.
+    if scene.daylight().is_some() {
+        return Err(Error::argument(
+            "scene",
+            "the patch baseline models lamps only, and the scene is lit by a [sky]: render it \
+             with the meshless solver or the path tracer"
+                .to_string(),
+        ));
+    }
     // The paper's baseline is diffuse radiosity: it would show mirrors and glass as matte.
     let specular: Vec<String> = scene
         .materials
