@@ -505,6 +505,50 @@ fn the_sun_and_a_perez_sky_in_the_office_match_the_path_tracer() {
     }
 }
 
+#[test]
+fn sunlight_alone_is_inter_reflected() {
+    // No sky at all, only the sun overhead through the roof opening, and grey walls: the
+    // shooting must not take the scene for unlit, and the floor outside the patch gets the
+    // patch's light back from the walls and the ceiling.
+    let mut scene = roof_light(0.5, false);
+    let sky = Sky::new(SkyModel::Uniform, 0.0, 0.0, 0.0).unwrap();
+    let daylight =
+        Daylight::new(sky, Vec3::Y, -Vec3::Z, 0.0, 0.0, Some((0.0, 0.0)), 50_000.0).unwrap();
+    scene.set_daylight(Some(daylight));
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    let s = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |_| {
+        Control::Continue
+    })
+    .unwrap();
+    assert_ne!(s.stop(), meshlight::solver::StopReason::NoLight);
+    // The patch: 1 m² at 50,000 lx, of which the floor (Kd 0.5) sends back half.
+    let entering = 50_000.0;
+    assert!(
+        (s.ledger().emitted.x / entering - 1.0).abs() < 0.02,
+        "{:?}",
+        s.ledger().emitted
+    );
+    let grid = Grid::new(
+        "corner",
+        Vec3::new(3.25, 0.01, 3.25),
+        Vec3::new(0.5, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.5),
+        Some(Vec3::Y),
+        Some(0.5),
+    )
+    .unwrap();
+    let e = illuminance(
+        &scene,
+        &s,
+        vis.as_ref(),
+        &grid,
+        &LuxOptions::default(),
+        &mut |_| Control::Continue,
+    )
+    .unwrap();
+    assert!(e.values[0].x > 100.0, "{:?}", e.values[0]);
+}
+
 /// The shipped office (or its open variant) at `width` × `height`.
 fn office(file: &str, width: u32, height: u32) -> Scene {
     let path = common::shipped("office").with_file_name(file);

@@ -231,6 +231,19 @@ impl DirectLight {
         }
     }
 
+    /// The sun alone (no lamps, no area lights), where daylight with sunlight enters the scene:
+    /// what it brings is daylight's share of the emitted power.
+    pub(crate) fn sun_only(scene: &Scene, light_samples: u32) -> Option<DirectLight> {
+        let mut light = DirectLight::new(scene, light_samples);
+        light.sun?;
+        light.emitters.clear();
+        light.points.clear();
+        light.specular = Specular::of(scene)
+            .any()
+            .then(|| (Specular::of(scene), Vec::new()));
+        Some(light)
+    }
+
     /// Direct light that also arrives by way of the scene's mirrors, panes and glass: through
     /// mirror images of the lights up to `depth` reflections, and through glass along straight
     /// lines (`specular::shadow`). A scene with none of them, or a depth of 0 (specular surfaces

@@ -342,10 +342,29 @@ impl Solve<'_> {
             (threads, self.ranks),
         )?;
         if round == 0 && !solution.daylight.is_empty() {
-            // Daylight is a source too: what enters is what the shooting measures against.
-            let entering: DVec3 = (0..n)
+            // Daylight is a source too: what enters is what the shooting measures against (the
+            // sky's and the ground's, and the sun's, which the samples' direct light holds
+            // mixed with the lamps': measured on its own here).
+            let mut entering: DVec3 = (0..n)
                 .map(|k| solution.daylight[k] * solution.samples.area[k])
                 .sum();
+            if let Some(sun) = DirectLight::sun_only(scene, options.light_samples) {
+                if !self.reporter.stopped() {
+                    let s = &solution.samples;
+                    let points: Vec<(Vec3, Vec3)> =
+                        (0..n).map(|k| (s.position[k], s.normal[k])).collect();
+                    let ids: Vec<u32> = (0..n as u32).collect();
+                    let mut quiet = |_: f64| crate::progress::Control::Continue;
+                    let (arrivals, q) =
+                        sun.at(vis, &points, &ids, options.seed, threads, &mut quiet)?;
+                    queries += q;
+                    entering += arrivals
+                        .iter()
+                        .zip(&s.area)
+                        .map(|(a, &area)| a.irradiance * area)
+                        .sum::<DVec3>();
+                }
+            }
             solution.ledger.emitted += entering;
         }
         if round == 0 {
