@@ -18,6 +18,16 @@ use meshlight::{Backend, Control, Options, RenderOptions, Scene};
 
 const EH: f64 = 10_000.0;
 
+/// Adds quad `c` to `b` wound so that its front faces `inward`.
+fn facing(b: &mut Builder, c: [Vec3; 4], inward: Vec3, m: u32) {
+    let n = (c[1] - c[0]).cross(c[2] - c[0]);
+    if n.dot(inward) > 0.0 {
+        b.quad(c, m);
+    } else {
+        b.quad([c[3], c[2], c[1], c[0]], m);
+    }
+}
+
 /// A 4 × 3 × 4 box (x, z in 0..4, y in 0..3) with a 1 × 1 opening in its roof over (2, 2),
 /// every face on one grid of corners so the opening is the only hole; inside faces of
 /// reflectance `kd`; with `pane`, a thin pane of index 1.52 5 cm over the opening.
@@ -28,14 +38,7 @@ fn roof_light(kd: f32, pane: bool) -> Scene {
     let (xs, ys, zs) = ([0.0, 1.5, 2.5, 4.0], [0.0, 3.0], [0.0, 1.5, 2.5, 4.0]);
     let v = Vec3::new;
     // Quads counter-clockwise seen from inside.
-    let mut face = |c: [Vec3; 4], inward: Vec3, m: u32| {
-        let n = (c[1] - c[0]).cross(c[2] - c[0]);
-        if n.dot(inward) > 0.0 {
-            b.quad(c, m);
-        } else {
-            b.quad([c[3], c[2], c[1], c[0]], m);
-        }
-    };
+    let mut face = |c: [Vec3; 4], inward: Vec3, m: u32| facing(&mut b, c, inward, m);
     for i in 0..3 {
         for j in 0..3 {
             let (x0, x1, z0, z1) = (xs[i], xs[i + 1], zs[j], zs[j + 1]);
@@ -131,14 +134,7 @@ fn facade_light(pane: bool) -> Scene {
     let glass = b.material(common::glass("pane", 1.52, true));
     let (xs, ys, zs) = ([0.0, 1.5, 2.5, 4.0], [0.0, 1.0, 2.0, 3.0], [0.0, 4.0]);
     let v = Vec3::new;
-    let mut face = |c: [Vec3; 4], inward: Vec3, m: u32| {
-        let n = (c[1] - c[0]).cross(c[2] - c[0]);
-        if n.dot(inward) > 0.0 {
-            b.quad(c, m);
-        } else {
-            b.quad([c[3], c[2], c[1], c[0]], m);
-        }
-    };
+    let mut face = |c: [Vec3; 4], inward: Vec3, m: u32| facing(&mut b, c, inward, m);
     for i in 0..3 {
         let (x0, x1) = (xs[i], xs[i + 1]);
         let (z0, z1) = (zs[0], zs[1]);

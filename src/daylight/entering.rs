@@ -22,6 +22,7 @@ use rand_pcg::Pcg64Mcg;
 
 use super::Daylight;
 use crate::error::Result;
+use crate::light::lattice;
 use crate::sampling::poisson::side_seed;
 use crate::scene::{Kind, Scene};
 use crate::specular::shadow::{self, LightPath};
@@ -153,15 +154,6 @@ fn portals(scene: &Scene) -> Vec<Portal> {
     out
 }
 
-/// Point `s` of a Fibonacci lattice of `count` in the unit square, shifted by `shift`
-/// (Cranley–Patterson).
-fn lattice(s: usize, count: usize, shift: (f64, f64)) -> (f64, f64) {
-    const GOLDEN: f64 = 0.618_033_988_749_894_8;
-    let u1 = ((s as f64 + 0.5) / count as f64 + shift.0).fract();
-    let u2 = (s as f64 * GOLDEN + shift.1).fract();
-    (u1, u2)
-}
-
 /// Where a ray from `origin` along unit `dir` crosses a triangle, if it does (t > 0).
 fn crossing(origin: Vec3, dir: Vec3, [a, b, c]: [Vec3; 3]) -> Option<f32> {
     let (e1, e2) = (b - a, c - a);
@@ -251,7 +243,7 @@ impl<'a> Entering<'a> {
             let shift = (rng.random::<f64>(), rng.random::<f64>());
             for i in 0..n_rays {
                 let dir = if i < aimed {
-                    let (u1, u2) = lattice(i, aimed, shift);
+                    let (u1, u2) = lattice(i as u32, aimed as u32, shift);
                     let pick = u1 * total;
                     let j = solid.partition_point(|&c| c <= pick).min(solid.len() - 1);
                     // Where in its share of the line the pick fell: the point's first
@@ -263,7 +255,7 @@ impl<'a> Entering<'a> {
                     (at - from).normalize_or_zero()
                 } else {
                     // Cosine-weighted over the receiver's hemisphere.
-                    let (u, v) = lattice(i - aimed, spread, shift);
+                    let (u, v) = lattice((i - aimed) as u32, spread as u32, shift);
                     let phi = std::f64::consts::TAU * v;
                     let r = u.sqrt();
                     (t * (r * phi.cos()) as f32

@@ -61,7 +61,7 @@ struct Emitter {
 
 /// Point `s` of a Fibonacci lattice of `count` in the unit square, shifted by `shift`
 /// (Cranley–Patterson): the first coordinate steps evenly, the second by the golden ratio.
-fn lattice(s: u32, count: u32, shift: (f64, f64)) -> (f64, f64) {
+pub(crate) fn lattice(s: u32, count: u32, shift: (f64, f64)) -> (f64, f64) {
     let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
     let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
     (u1, u2)

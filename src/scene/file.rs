@@ -477,24 +477,9 @@ fn local_time(text: &str, timezone: f64) -> std::result::Result<LocalTime, Strin
         Some(s) => s.parse::<f64>().map_err(|_| bad())?,
         None => 0.0,
     };
-    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
-    let days = [
-        31,
-        if leap { 29 } else { 28 },
-        31,
-        30,
-        31,
-        30,
-        31,
-        31,
-        30,
-        31,
-        30,
-        31,
-    ];
     let valid = (1..=12).contains(&month)
         && day >= 1
-        && day <= days[(month.clamp(1, 12) - 1) as usize]
+        && day <= month_days(year)[(month.clamp(1, 12) - 1) as usize]
         && hour < 24
         && minute < 60
         && (0.0..60.0).contains(&second)
@@ -513,10 +498,10 @@ fn local_time(text: &str, timezone: f64) -> std::result::Result<LocalTime, Strin
     })
 }
 
-/// The day of the year (1–366) of a date.
-fn day_of_year(t: &LocalTime) -> u32 {
-    let leap = (t.year % 4 == 0 && t.year % 100 != 0) || t.year % 400 == 0;
-    let days = [
+/// The days of each month of a year (Gregorian).
+fn month_days(year: i32) -> [u32; 12] {
+    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    [
         31,
         if leap { 29 } else { 28 },
         31,
@@ -529,8 +514,15 @@ fn day_of_year(t: &LocalTime) -> u32 {
         31,
         30,
         31,
-    ];
-    days[..(t.month as usize - 1)].iter().sum::<u32>() + t.day
+    ]
+}
+
+/// The day of the year (1–366) of a date.
+fn day_of_year(t: &LocalTime) -> u32 {
+    month_days(t.year)[..(t.month as usize - 1)]
+        .iter()
+        .sum::<u32>()
+        + t.day
 }
 
 /// `[site]` and `[sky]` as the daylight outside; errors name the table's line.
