@@ -45,6 +45,7 @@
 //! without breaking a host. Structs that may grow fields are `#[non_exhaustive]`. Before 1.0 a
 //! minor version may still change the interface, and its notes say how.
 
+pub mod annual;
 mod area;
 pub mod budget;
 pub mod daylight;

@@ -22,7 +22,7 @@ use crate::specular::Specular;
 use crate::visibility::{Segment, Visibility};
 
 /// Rays per grid point towards the sky and the ground, where daylight enters a scene.
-const GRID_SKY_RAYS: u32 = 4096;
+pub(crate) const GRID_SKY_RAYS: u32 = 4096;
 
 /// How grid points are measured.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,41 +158,18 @@ pub fn illuminance(
                 )?,
                 None => vec![DVec3::ZERO; out.len()],
             };
+            let (mut segments, mut factors) = (Vec::new(), Vec::new());
             for ((o, &x), extra) in out.iter_mut().zip(&points[first..]).zip(by_way_of_specular) {
-                let mut segments = Vec::new();
-                let mut shares = Vec::new();
-                for (k, reflected) in reflected.iter().enumerate() {
-                    if reflected.max_element() <= 0.0 {
-                        continue;
-                    }
-                    let (y, m) = (s.position[k], s.normal[k]);
-                    let d = y - x;
-                    let r2 = d.length_squared();
-                    if r2 <= 0.0 {
-                        continue;
-                    }
-                    let r = r2.sqrt();
-                    let (cos_x, cos_y) = (n.dot(d) / r, -m.dot(d) / r);
-                    if cos_x <= 0.0 || cos_y <= 0.0 {
-                        continue;
-                    }
-                    let area = s.area[k];
-                    let factor = area * f64::from(cos_x * cos_y)
-                        / (std::f64::consts::PI * f64::from(r2) + area);
-                    segments.push(Segment {
-                        a: x,
-                        b: y + lift * m,
-                    });
-                    shares.push(*reflected * factor);
-                }
+                let lit = |k: usize| reflected[k].max_element() > 0.0;
+                facing(s, (x, n), lift, lit, &mut segments, &mut factors);
                 let mut blocked = vec![false; segments.len()];
                 vis.occluded(&segments, &mut blocked)?;
                 *o = Some(
-                    shares
+                    factors
                         .iter()
                         .zip(&blocked)
                         .filter(|(_, &b)| !b)
-                        .map(|(e, _)| *e)
+                        .map(|(&(k, f), _)| reflected[k as usize] * f)
                         .sum::<DVec3>()
                         + extra,
                 );
@@ -220,6 +197,88 @@ pub fn illuminance(
             .collect();
         Ok(Illuminance { values, measured })
     })
+}
+
+/// The samples that face grid point `x` (facing `n`) and that `wanted` keeps: each one's
+/// point-to-disc form factor Aⱼ cosθ cosθⱼ / (πr² + Aⱼ) in `factors`, and in `segments` the
+/// segment whose visibility decides whether it counts (both cleared first).
+fn facing(
+    s: &crate::sampling::Samples,
+    (x, n): (Vec3, Vec3),
+    lift: f32,
+    wanted: impl Fn(usize) -> bool,
+    segments: &mut Vec<Segment>,
+    factors: &mut Vec<(u32, f64)>,
+) {
+    segments.clear();
+    factors.clear();
+    for k in 0..s.len() {
+        if !wanted(k) {
+            continue;
+        }
+        let (y, m) = (s.position[k], s.normal[k]);
+        let d = y - x;
+        let r2 = d.length_squared();
+        if r2 <= 0.0 {
+            continue;
+        }
+        let r = r2.sqrt();
+        let (cos_x, cos_y) = (n.dot(d) / r, -m.dot(d) / r);
+        if cos_x <= 0.0 || cos_y <= 0.0 {
+            continue;
+        }
+        let area = s.area[k];
+        let factor =
+            area * f64::from(cos_x * cos_y) / (std::f64::consts::PI * f64::from(r2) + area);
+        segments.push(Segment {
+            a: x,
+            b: y + lift * m,
+        });
+        factors.push((k as u32, factor));
+    }
+}
+
+/// Per grid point, what each sample's reflected radiosity gives it: the inter-reflected part
+/// of [`illuminance`] as a sparse linear map (sample, weight), for a host of many lightings of
+/// one solution (a year of daylight coefficients). Direct light is not in it.
+pub(crate) fn gather_rows(
+    scene: &Scene,
+    solution: &Solution,
+    vis: &dyn Visibility,
+    grid: &Grid,
+    options: &LuxOptions,
+    report: &mut dyn FnMut(f64) -> crate::progress::Control,
+) -> Result<Vec<Vec<(u32, Vec3)>>> {
+    let points = grid.points();
+    let n = grid.normal;
+    let s = &solution.samples;
+    let lift = crate::visibility::lift(scene);
+    let specular = specular_gather(scene, solution, vis, options)?;
+    let mut rows: Vec<Vec<(u32, Vec3)>> = vec![Vec::new(); points.len()];
+    let gather = |first: usize, out: &mut [Vec<(u32, Vec3)>]| {
+        let through = match &specular {
+            Some(g) => g.rows(&points[first..first + out.len()], n, first as u32)?,
+            None => vec![Vec::new(); out.len()],
+        };
+        let (mut segments, mut factors) = (Vec::new(), Vec::new());
+        for ((row, &x), mut extra) in out.iter_mut().zip(&points[first..]).zip(through) {
+            facing(s, (x, n), lift, |_| true, &mut segments, &mut factors);
+            let mut blocked = vec![false; segments.len()];
+            vis.occluded(&segments, &mut blocked)?;
+            row.extend(
+                factors
+                    .iter()
+                    .zip(&blocked)
+                    .filter(|(_, &b)| !b)
+                    .map(|(&(k, f), _)| (k, Vec3::splat(f as f32))),
+            );
+            row.append(&mut extra);
+            row.shrink_to_fit();
+        }
+        Ok(())
+    };
+    for_chunks_reporting(&mut rows, 4, options.threads.max(1), gather, report)?;
+    Ok(rows)
 }
 
 /// Light by way of specular surfaces at grid points: chains from each point
@@ -268,6 +327,43 @@ impl SpecularGather<'_> {
         first: u32,
         reflected: &[DVec3],
     ) -> Result<Vec<DVec3>> {
+        let (mut out, ends) = self.ends(points, normal, first)?;
+        for (receiver, weight, chosen) in ends {
+            let b: DVec3 = chosen
+                .iter()
+                .map(|&(k, w)| reflected[k as usize] * f64::from(w))
+                .sum();
+            // A local-linear fit may extrapolate below zero near a dark edge.
+            out[receiver as usize] += weight * b.max(DVec3::ZERO);
+        }
+        Ok(out)
+    }
+
+    /// [`SpecularGather::at`] as a linear map: per point, (sample, weight) of the chains' ends
+    /// (without the fit's floor at zero, which a sum of bases cannot hold).
+    fn rows(&self, points: &[Vec3], normal: Vec3, first: u32) -> Result<Vec<Vec<(u32, Vec3)>>> {
+        let (_, ends) = self.ends(points, normal, first)?;
+        let mut rows = vec![Vec::new(); points.len()];
+        for (receiver, weight, chosen) in ends {
+            let row: &mut Vec<(u32, Vec3)> = &mut rows[receiver as usize];
+            row.extend(
+                chosen
+                    .iter()
+                    .map(|&(k, w)| (k, (weight * f64::from(w)).as_vec3())),
+            );
+        }
+        Ok(rows)
+    }
+
+    /// The lights' light through glossy bounces at each point, and every chain's end: its
+    /// point, its weight, and the samples it interpolates with their normalised weights.
+    #[allow(clippy::type_complexity)]
+    fn ends(
+        &self,
+        points: &[Vec3],
+        normal: Vec3,
+        first: u32,
+    ) -> Result<(Vec<DVec3>, Vec<(u32, DVec3, Vec<(u32, f32)>)>)> {
         let has_samples = |side| self.interpolator.has_samples(side);
         let highlights = Highlights::of(self.scene, &self.spec);
         // No photon lands on a grid point: its chains take the lights they meet where the
@@ -307,20 +403,15 @@ impl SpecularGather<'_> {
             .collect();
         let mut weights = Vec::new();
         self.interpolator.weights(&sites, &mut weights)?;
-        let mut out = found.direct;
-        for (e, chosen) in found.ends.iter().zip(&weights) {
-            let total: f64 = chosen.iter().map(|&(_, w)| f64::from(w)).sum();
+        let mut ends = Vec::with_capacity(found.ends.len());
+        for (e, chosen) in found.ends.iter().zip(weights) {
+            let total: f32 = chosen.iter().map(|&(_, w)| w).sum();
             if total > 0.0 {
-                let b: DVec3 = chosen
-                    .iter()
-                    .map(|&(k, w)| reflected[k as usize] * f64::from(w))
-                    .sum::<DVec3>()
-                    / total;
-                // A local-linear fit may extrapolate below zero near a dark edge.
-                out[e.receiver as usize] += e.weight * b.max(DVec3::ZERO);
+                let chosen = chosen.into_iter().map(|(k, w)| (k, w / total)).collect();
+                ends.push((e.receiver, e.weight, chosen));
             }
         }
-        Ok(out)
+        Ok((found.direct, ends))
     }
 }
 

@@ -38,6 +38,10 @@ pub enum Phase {
     Tracing,
     /// Cutting the surfaces into patches (patches).
     Meshing,
+    /// Shooting each sky patch's and sun position's light (a year of daylight).
+    Coefficients,
+    /// Summing the hours of a year of daylight.
+    Hours,
 }
 
 impl Phase {
@@ -55,6 +59,8 @@ impl Phase {
             Phase::Gathering => "gathering",
             Phase::Tracing => "path tracing",
             Phase::Meshing => "meshing",
+            Phase::Coefficients => "daylight coefficients",
+            Phase::Hours => "hours of the year",
         }
     }
 }

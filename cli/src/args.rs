@@ -335,6 +335,23 @@ pub enum Command {
               value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::solver::MAX_SPECULAR_RAYS)))]
         grid_specular_rays: u32,
     },
+    /// A year of weather ([annual]) at the scene's grids: per grid DIR/<grid>.csv with each
+    /// point's daylight autonomy, useful daylight, direct-sun hours and yearly exposure, and a
+    /// line with sDA, ASE, the EN 17037 verdict and the largest exposure.
+    Annual {
+        #[command(flatten)]
+        solve: SolveArgs,
+        /// Folder for the CSVs.
+        #[arg(short, long, default_value = ".")]
+        output: PathBuf,
+        /// Also write DIR/<grid>-hourly.csv: every hour's illuminance at every point.
+        #[arg(long)]
+        hourly: bool,
+        /// Shadow rays per grid point to the sun's disc (at most 16 are used).
+        #[arg(long, default_value_t = 16,
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
+        grid_light_samples: u32,
+    },
     /// Solve a scene and write a lighting report: one self-contained HTML page (DIR/index.html)
     /// with the luminaire schedule, every grid's figures and targets, the isolux plans, the
     /// rendered view and how it was computed; the grids' CSVs and plans beside it

@@ -3,6 +3,7 @@
 mod args;
 mod bench;
 mod errors;
+mod annual;
 mod lux;
 mod memory;
 mod page;
@@ -108,6 +109,26 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
                 threads: options.threads,
             };
             lux::run(&scene, &solution, vis.as_ref(), &lux, &output)
+        }
+        Command::Annual {
+            solve,
+            output,
+            hourly,
+            grid_light_samples,
+        } => {
+            let (scene, options) = solve_setup(&solve, loading)?;
+            let vis = backend_from(&solve.knobs).build(&scene)?;
+            let annual = meshlight::annual::AnnualOptions {
+                lux: meshlight::lux::LuxOptions {
+                    light_samples: grid_light_samples.max(1),
+                    seed: options.seed,
+                    threads: options.threads,
+                    ..meshlight::lux::LuxOptions::default()
+                },
+                solver: options,
+                hourly,
+            };
+            annual::run(&scene, vis.as_ref(), &annual, &output)
         }
         Command::Report {
             solve,

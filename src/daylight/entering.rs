@@ -49,6 +49,17 @@ struct Portal {
     centroid: Vec3,
 }
 
+/// A ray that leaves the model: what one unit of luminance along it gives its receiver.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Escape {
+    /// The receiver's index in the points asked about.
+    pub receiver: u32,
+    /// Towards the sky or the ground (unit).
+    pub dir: Vec3,
+    /// The glass's transmittance × the ray's weight (cos θ over its density × rays).
+    pub light: DVec3,
+}
+
 /// The daylight entering a scene, ready to be measured at points.
 pub(crate) struct Entering<'a> {
     daylight: &'a Daylight,
@@ -203,6 +214,24 @@ impl<'a> Entering<'a> {
         ids: &[u32],
         seed: u64,
     ) -> Result<(Vec<DVec3>, u64)> {
+        let (escapes, queries) = self.escapes(vis, points, ids, seed)?;
+        let mut out = vec![DVec3::ZERO; points.len()];
+        for e in escapes {
+            out[e.receiver as usize] += e.light * self.daylight.radiance(e.dir);
+        }
+        Ok((out, queries))
+    }
+
+    /// The rays of [`Entering::at`] that leave the model: the irradiance at receiver r is
+    /// Σ L(dir) × light over its escapes, whatever the sky's luminance L (daylight
+    /// coefficients bin them by sky patch).
+    pub(crate) fn escapes(
+        &self,
+        vis: &dyn Visibility,
+        points: &[(Vec3, Vec3)],
+        ids: &[u32],
+        seed: u64,
+    ) -> Result<(Vec<Escape>, u64)> {
         let n_rays = self.rays as usize;
         let mut dirs: Vec<Vec3> = Vec::with_capacity(points.len() * n_rays);
         // Per ray: cos θ at the receiver over the mixture's density × rays (the weight of
@@ -345,12 +374,16 @@ impl<'a> Entering<'a> {
                 }
             }
         }
-        let mut out = vec![DVec3::ZERO; points.len()];
-        for i in live {
-            let l = self.daylight.radiance(dirs[i]);
-            out[i / n_rays] += shares[i] * (l * weights[i]);
-        }
-        Ok((out, queries))
+        let escapes = live
+            .into_iter()
+            .filter(|&i| shares[i] != DVec3::ZERO)
+            .map(|i| Escape {
+                receiver: (i / n_rays) as u32,
+                dir: dirs[i],
+                light: shares[i] * weights[i],
+            })
+            .collect();
+        Ok((escapes, queries))
     }
 }
 

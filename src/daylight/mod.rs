@@ -3,13 +3,15 @@
 //! skies, Perez all-weather).
 
 pub(crate) mod entering;
+pub mod epw;
+pub mod patches;
 mod site;
 pub mod sky;
 pub mod spa;
 mod spa_tables;
 mod view;
 
-pub use site::{Daylight, MAX_ILLUMINANCE, SUN_RADIUS_DEGREES};
+pub use site::{AnnualSettings, Daylight, Site, MAX_ILLUMINANCE, SUN_RADIUS_DEGREES};
 pub use sky::{Sky, SkyModel};
 pub use spa::{sun_position, LocalTime, Observer, SunPosition};
 pub use view::{sky_view, SkyView};
@@ -22,4 +24,20 @@ pub(crate) fn human(x: f64) -> String {
     } else {
         format!("{x:e}")
     }
+}
+
+/// The days in a month (1-12) of a Gregorian year.
+pub fn days_in_month(year: i32, month: u32) -> u32 {
+    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    match month {
+        2 if leap => 29,
+        2 => 28,
+        4 | 6 | 9 | 11 => 30,
+        _ => 31,
+    }
+}
+
+/// The day of the year (1-366) of a date.
+pub fn day_of_year(year: i32, month: u32, day: u32) -> u32 {
+    (1..month).map(|m| days_in_month(year, m)).sum::<u32>() + day
 }

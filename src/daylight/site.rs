@@ -6,6 +6,50 @@ use glam::{DVec3, Vec3};
 use super::sky::Sky;
 use crate::error::{Error, Result};
 
+/// Where a building stands (`[site]`): each key optional, with the defaults scene-format v4
+/// gives (north −z, up +y, ground reflectance 0.2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Site {
+    /// Degrees, north positive.
+    pub latitude: Option<f64>,
+    /// Degrees, east positive.
+    pub longitude: Option<f64>,
+    /// Hours east of UTC of the local standard time.
+    pub timezone: Option<f64>,
+    /// The horizontal scene direction of true north.
+    pub north: Vec3,
+    /// The zenith.
+    pub up: Vec3,
+    /// The ground's reflectance outside the model.
+    pub ground_reflectance: f64,
+}
+
+impl Default for Site {
+    fn default() -> Self {
+        Site {
+            latitude: None,
+            longitude: None,
+            timezone: None,
+            north: -Vec3::Z,
+            up: Vec3::Y,
+            ground_reflectance: 0.2,
+        }
+    }
+}
+
+/// A year of weather (`[annual]`): what `meshlight annual` computes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnnualSettings {
+    /// The EnergyPlus weather file.
+    pub weather: std::path::PathBuf,
+    /// Occupied hours [start, end), local standard time.
+    pub hours: (u32, u32),
+    /// Reinhart's MF (1: Tregenza's 145 patches).
+    pub sky_subdivision: u32,
+    /// The `[site]` (its latitude, longitude and time zone default to the weather file's).
+    pub site: Site,
+}
+
 /// The daylight outside a scene: what a ray leaving the model sees.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Daylight {

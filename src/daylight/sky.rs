@@ -217,6 +217,38 @@ pub fn perez_parameters(
     (e, d)
 }
 
+/// Direct normal and diffuse horizontal illuminance (lx) from the irradiances (W/m²) at a sun
+/// zenith angle (degrees) on a day of the year, by Perez's 1990 luminous efficacies (the
+/// clearness bin, brightness and precipitable water as in [`perez_parameters`]): how a weather
+/// file without illuminance is read.
+pub(crate) fn illuminance_of_irradiance(
+    direct_normal: f64,
+    diffuse_horizontal: f64,
+    zenith: f64,
+    day_of_year: u32,
+) -> (f64, f64) {
+    if diffuse_horizontal <= 0.0 && direct_normal <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let zenith = zenith.clamp(0.0, 90.0);
+    let e = if diffuse_horizontal > 0.0 {
+        clearness(diffuse_horizontal, direct_normal, zenith)
+            .clamp(CLEARNESS_RANGE.0, CLEARNESS_RANGE.1)
+    } else {
+        CLEARNESS_RANGE.1
+    };
+    let extraterrestrial = SOLAR_CONSTANT_W * eccentricity(day_of_year);
+    let d = (diffuse_horizontal * air_mass(zenith) / extraterrestrial)
+        .clamp(BRIGHTNESS_RANGE.0, BRIGHTNESS_RANGE.1);
+    let (w, cos_z) = (precipitable_water(), zenith.to_radians().cos());
+    let bin = clearness_bin(e);
+    let [a, b, c, dd] = DIFFUSE_EFFICACY[bin];
+    let diffuse = diffuse_horizontal * (a + b * w + c * cos_z + dd * d.ln()).max(0.0);
+    let [a, b, c, dd] = DIRECT_EFFICACY[bin];
+    let k = (a + b * w + c * (5.73 * zenith.to_radians() - 5.0).exp() + dd * d).max(0.0);
+    (direct_normal * k, diffuse)
+}
+
 /// The five Perez coefficients a–e for clearness ε, brightness Δ and sun zenith Z (radians),
 /// with the 1993 paper's correction Δ ≥ 0.2 for 1.065 < ε < 2.8, as `gendaylit` applies it.
 pub fn perez_coefficients(clearness: f64, brightness: f64, sun_zenith: f64) -> [f64; 5] {
@@ -269,19 +301,35 @@ impl Sky {
         sun_azimuth: f64,
         diffuse_horizontal: f64,
     ) -> Result<Sky> {
+        if !(0.0..=super::site::MAX_ILLUMINANCE).contains(&diffuse_horizontal) {
+            return Err(Error::Option {
+                option: "sky",
+                problem: format!(
+                    "diffuse_horizontal {} is not an illuminance in 0 to {:e}",
+                    super::human(diffuse_horizontal),
+                    super::site::MAX_ILLUMINANCE
+                ),
+            });
+        }
+        let mut sky = Sky::unscaled(model, sun_zenith, sun_azimuth)?;
+        let unscaled = sky.horizontal_illuminance();
+        sky.scale = if unscaled > 0.0 {
+            diffuse_horizontal / unscaled
+        } else {
+            0.0
+        };
+        Ok(sky)
+    }
+
+    /// The sky's shape, luminance 1 × the model's relative luminance (no normalising
+    /// integral): for a host that scales many skies itself (a year of daylight).
+    pub(crate) fn unscaled(model: SkyModel, sun_zenith: f64, sun_azimuth: f64) -> Result<Sky> {
         let bad = |problem: String| {
             Err(Error::Option {
                 option: "sky",
                 problem,
             })
         };
-        if !(0.0..=super::site::MAX_ILLUMINANCE).contains(&diffuse_horizontal) {
-            return bad(format!(
-                "diffuse_horizontal {} is not an illuminance in 0 to {:e}",
-                super::human(diffuse_horizontal),
-                super::site::MAX_ILLUMINANCE
-            ));
-        }
         if !(sun_zenith.is_finite() && sun_azimuth.is_finite()) {
             return bad("the sun's position is not finite".into());
         }
@@ -303,20 +351,14 @@ impl Sky {
             }
             _ => [0.0; 5],
         };
-        let mut sky = Sky {
+        Ok(Sky {
             model,
             sun: (sun_zenith.to_radians(), sun_azimuth.to_radians()),
             coefficients,
             scale: 1.0,
-        };
-        let unscaled = sky.horizontal_illuminance();
-        sky.scale = if unscaled > 0.0 {
-            diffuse_horizontal / unscaled
-        } else {
-            0.0
-        };
-        Ok(sky)
+        })
     }
+
 
     /// The model.
     pub fn model(&self) -> SkyModel {

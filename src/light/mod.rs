@@ -244,6 +244,32 @@ impl DirectLight {
         Some(light)
     }
 
+    /// The sun alone towards unit scene direction `dir`, delivering 1 on a plane facing it,
+    /// whatever the scene's own sky: a year of weather's sunlight, hour by hour
+    /// ([`DirectLight::aim_sun`]).
+    pub(crate) fn unit_sun(scene: &Scene, light_samples: u32, dir: Vec3) -> DirectLight {
+        let mut light = DirectLight::new(scene, light_samples);
+        light.emitters.clear();
+        light.points.clear();
+        let spec = Specular::of(scene);
+        light.specular = spec.any().then(|| (spec, Vec::new()));
+        light.sun = Some(Sun {
+            dir,
+            illuminance: 1.0,
+            across: dir.any_orthonormal_pair(),
+            far: 2.0 * scene.bounds.diagonal() + 1.0,
+        });
+        light
+    }
+
+    /// Points the sun at unit scene direction `dir` (a light with a sun only).
+    pub(crate) fn aim_sun(&mut self, dir: Vec3) {
+        if let Some(sun) = &mut self.sun {
+            sun.dir = dir;
+            sun.across = dir.any_orthonormal_pair();
+        }
+    }
+
     /// Direct light that also arrives by way of the scene's mirrors, panes and glass: through
     /// mirror images of the lights up to `depth` reflections, and through glass along straight
     /// lines (`specular::shadow`). A scene with none of them, or a depth of 0 (specular surfaces

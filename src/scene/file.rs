@@ -11,7 +11,7 @@ use toml::Spanned;
 use super::overrides::Override;
 use super::{luminance, validate, Camera, Grid, Luminaire, PointLight, SolverDefaults, Units};
 use crate::daylight::spa::{sun_position, LocalTime, Observer};
-use crate::daylight::{Daylight, Sky, SkyModel};
+use crate::daylight::{Daylight, Site, Sky, SkyModel};
 use crate::error::{Error, Result};
 use crate::ies::Photometry;
 
@@ -36,6 +36,15 @@ struct SceneToml {
     material: std::collections::BTreeMap<String, Spanned<MaterialToml>>,
     site: Option<Spanned<SiteToml>>,
     sky: Option<Spanned<SkyToml>>,
+    annual: Option<Spanned<AnnualToml>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AnnualToml {
+    weather: String,
+    hours: Option<[i64; 2]>,
+    sky_subdivision: Option<u32>,
 }
 
 #[derive(Deserialize)]
@@ -164,6 +173,8 @@ pub(super) struct SceneFile {
     pub obj_notes: Vec<String>,
     /// `[site]` and `[sky]`: the daylight outside.
     pub daylight: Option<crate::daylight::Daylight>,
+    /// `[site]` and `[annual]`: a year of weather.
+    pub annual: Option<crate::daylight::AnnualSettings>,
 }
 
 impl SceneFile {
@@ -180,6 +191,7 @@ impl SceneFile {
             solver: SolverDefaults::default(),
             overrides: Vec::new(),
             daylight: None,
+            annual: None,
             obj_line: 1,
             obj_notes: Vec::new(),
         }
@@ -369,7 +381,36 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         solver.max_reflectance = s.max_reflectance;
     }
 
-    let daylight = daylight(parsed.site, parsed.sky, &at)?;
+    let (site_span, site) = match parsed.site {
+        Some(s) => {
+            let span = s.span();
+            (Some(span.clone()), Some(site(s.into_inner(), span, &at)?))
+        }
+        None => (None, None),
+    };
+    if let (Some(span), None, None) = (&site_span, &parsed.sky, &parsed.annual) {
+        return Err(at(
+            span.clone(),
+            "[site] without a [sky] or an [annual]: give the sky (model = \"cie-overcast\", \
+             say)"
+                .into(),
+        ));
+    }
+    let site_fail = |problem: String, fallback: &Range<usize>| match &site_span {
+        Some(span) => at(span.clone(), format!("[site] {problem}")),
+        None => at(fallback.clone(), problem),
+    };
+    let daylight = match parsed.sky {
+        Some(sky) => Some(daylight(site.as_ref(), sky, &at, &site_fail)?),
+        None => None,
+    };
+    let annual = match parsed.annual {
+        Some(a) => {
+            let span = a.span();
+            Some(annual(dir, site, a.into_inner(), &|p| at(span.clone(), format!("[annual] {p}")))?)
+        }
+        None => None,
+    };
 
     let line = |span: Range<usize>| line_of(text, span.start);
     let rgb = |v: Spanned<[f32; 3]>| (Vec3::from(*v.get_ref()), line(v.span()));
@@ -454,6 +495,7 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         obj_line: line_of(text, obj_span.start),
         obj_notes,
         daylight,
+        annual,
     })
 }
 
@@ -479,7 +521,7 @@ fn local_time(text: &str, timezone: f64) -> std::result::Result<LocalTime, Strin
     };
     let valid = (1..=12).contains(&month)
         && day >= 1
-        && day <= month_days(year)[(month.clamp(1, 12) - 1) as usize]
+        && day <= crate::daylight::days_in_month(year, month.clamp(1, 12))
         && hour < 24
         && minute < 60
         && (0.0..60.0).contains(&second)
@@ -498,68 +540,14 @@ fn local_time(text: &str, timezone: f64) -> std::result::Result<LocalTime, Strin
     })
 }
 
-/// The days of each month of a year (Gregorian).
-fn month_days(year: i32) -> [u32; 12] {
-    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
-    [
-        31,
-        if leap { 29 } else { 28 },
-        31,
-        30,
-        31,
-        30,
-        31,
-        31,
-        30,
-        31,
-        30,
-        31,
-    ]
-}
 
-/// The day of the year (1–366) of a date.
-fn day_of_year(t: &LocalTime) -> u32 {
-    month_days(t.year)[..(t.month as usize - 1)]
-        .iter()
-        .sum::<u32>()
-        + t.day
-}
 
-/// `[site]` and `[sky]` as the daylight outside; errors name the table's line.
-fn daylight(
-    site: Option<Spanned<SiteToml>>,
-    sky: Option<Spanned<SkyToml>>,
+/// `[site]`, checked: its keys within their ranges; errors name the table's line.
+fn site(
+    s: SiteToml,
+    span: Range<usize>,
     at: &dyn Fn(Range<usize>, String) -> Error,
-) -> Result<Option<Daylight>> {
-    let Some(sky) = sky else {
-        return match site {
-            Some(s) => Err(at(
-                s.span(),
-                "[site] without a [sky]: give the sky (model = \"cie-overcast\", say)".into(),
-            )),
-            None => Ok(None),
-        };
-    };
-    let (sky_span, k) = (sky.span(), sky.into_inner());
-    let fail = |problem: String| at(sky_span.clone(), format!("[sky] {problem}"));
-    let (site_span, s) = match site {
-        Some(s) => (Some(s.span()), s.into_inner()),
-        None => (
-            None,
-            SiteToml {
-                latitude: None,
-                longitude: None,
-                timezone: None,
-                north: None,
-                up: None,
-                ground_reflectance: None,
-            },
-        ),
-    };
-    let site_fail = |problem: String| match &site_span {
-        Some(span) => at(span.clone(), format!("[site] {problem}")),
-        None => fail(problem),
-    };
+) -> Result<Site> {
     for (name, value, range) in [
         ("latitude", s.latitude, -90.0..=90.0),
         ("longitude", s.longitude, -180.0..=180.0),
@@ -567,13 +555,69 @@ fn daylight(
         ("ground_reflectance", s.ground_reflectance, 0.0..=1.0),
     ] {
         if let Some(v) = value.filter(|v| !range.contains(v)) {
-            return Err(site_fail(format!(
-                "{name} = {v} is outside {} to {}",
-                range.start(),
-                range.end()
-            )));
+            return Err(at(
+                span,
+                format!(
+                    "[site] {name} = {v} is outside {} to {}",
+                    range.start(),
+                    range.end()
+                ),
+            ));
         }
     }
+    Ok(Site {
+        latitude: s.latitude,
+        longitude: s.longitude,
+        timezone: s.timezone,
+        north: s.north.map_or(-Vec3::Z, Vec3::from),
+        up: s.up.map_or(Vec3::Y, Vec3::from),
+        ground_reflectance: s.ground_reflectance.unwrap_or(0.2),
+    })
+}
+
+/// `[annual]`: the weather file (relative to the scene file's folder), the occupied hours and
+/// the sky's subdivision; errors name the table's line.
+fn annual(
+    dir: &Path,
+    site: Option<Site>,
+    a: AnnualToml,
+    fail: &dyn Fn(String) -> Error,
+) -> Result<crate::daylight::AnnualSettings> {
+    let hours = a.hours.unwrap_or([8, 18]);
+    if !(0 <= hours[0] && hours[0] < hours[1] && hours[1] <= 24) {
+        return Err(fail(format!(
+            "hours = [{}, {}]: the occupied hours are [start, end) with 0 ≤ start < end ≤ 24",
+            hours[0], hours[1]
+        )));
+    }
+    let subdivision = a.sky_subdivision.unwrap_or(1);
+    if ![1, 2, 4].contains(&subdivision) {
+        return Err(fail(format!(
+            "sky_subdivision = {subdivision}: 1 (Tregenza's 145 patches), 2 (577) or 4 (2305)"
+        )));
+    }
+    if a.weather.trim().is_empty() {
+        return Err(fail("weather names no file".into()));
+    }
+    Ok(crate::daylight::AnnualSettings {
+        weather: dir.join(&a.weather),
+        hours: (hours[0] as u32, hours[1] as u32),
+        sky_subdivision: subdivision,
+        site: site.unwrap_or_default(),
+    })
+}
+
+/// `[sky]` over the `[site]` as the daylight outside; errors name the table's line.
+fn daylight(
+    site: Option<&Site>,
+    sky: Spanned<SkyToml>,
+    at: &dyn Fn(Range<usize>, String) -> Error,
+    site_fail: &dyn Fn(String, &Range<usize>) -> Error,
+) -> Result<Daylight> {
+    let (sky_span, k) = (sky.span(), sky.into_inner());
+    let fail = |problem: String| at(sky_span.clone(), format!("[sky] {problem}"));
+    let site_fail = |problem: String| site_fail(problem, &sky_span);
+    let s = site.cloned().unwrap_or_default();
     let sun_needed = !matches!(k.model.as_str(), "cie-overcast" | "uniform");
     let model = match (k.model.as_str(), k.kind) {
         ("cie-overcast", None) => SkyModel::CieOvercast,
@@ -643,7 +687,7 @@ fn daylight(
             };
             let year = f64::from(time.year) + (f64::from(time.month) - 0.5) / 12.0;
             let sun = sun_position(&time, &observer, crate::daylight::spa::delta_t(year));
-            (Some((sun.zenith, sun.azimuth)), Some(day_of_year(&time)))
+            (Some((sun.zenith, sun.azimuth)), Some(crate::daylight::day_of_year(time.year, time.month, time.day)))
         }
         (None, Some(alt), Some(az)) => {
             if !((-90.0..=90.0).contains(&alt) && az.is_finite()) {
@@ -683,18 +727,15 @@ fn daylight(
         m => m,
     };
     let sky = Sky::new(model, zenith, azimuth, diffuse).map_err(|e| fail(e.to_string()))?;
-    let up = s.up.map_or(Vec3::Y, Vec3::from);
-    let north = s.north.map_or(-Vec3::Z, Vec3::from);
     Daylight::new(
         sky,
-        up,
-        north,
-        s.ground_reflectance.unwrap_or(0.2),
+        s.up,
+        s.north,
+        s.ground_reflectance,
         diffuse,
         sun,
         direct,
     )
-    .map(Some)
     .map_err(|e| site_fail(e.to_string()))
 }
 

@@ -265,6 +265,8 @@ pub struct Scene {
     pub(crate) warnings: Vec<String>,
     /// The sky and ground outside (scene-format v4), if daylight enters the scene.
     pub(crate) daylight: Option<crate::daylight::Daylight>,
+    /// A year of weather (`[annual]`), if the scene file asks for one.
+    pub(crate) annual: Option<crate::daylight::AnnualSettings>,
 }
 
 impl Scene {
@@ -276,6 +278,16 @@ impl Scene {
     /// The daylight outside (`[site]` and `[sky]`), if any.
     pub fn daylight(&self) -> Option<&crate::daylight::Daylight> {
         self.daylight.as_ref()
+    }
+
+    /// The year of weather `meshlight annual` computes (`[annual]`), if any.
+    pub fn annual(&self) -> Option<&crate::daylight::AnnualSettings> {
+        self.annual.as_ref()
+    }
+
+    /// Sets (or, with `None`, removes) the year of weather: a host's own.
+    pub fn set_annual(&mut self, annual: Option<crate::daylight::AnnualSettings>) {
+        self.annual = annual;
     }
 
     /// Lets daylight in (or, with `None`, keeps it out): a host's own sky.
@@ -522,6 +534,7 @@ impl Scene {
         scene.units = file.units;
         scene.grids = file.grids;
         scene.daylight = file.daylight;
+        scene.annual = file.annual;
         warnings.append(&mut scene.warnings);
         scene.warnings = warnings;
         Ok(scene)
@@ -618,6 +631,7 @@ impl Scene {
             bounds,
             warnings,
             daylight: None,
+            annual: None,
         })
     }
 

@@ -8,6 +8,7 @@
 //! (`normalise`) and run their heavy work on the same ordered pipeline (`pipeline`).
 
 mod balance;
+pub(crate) mod basis;
 mod cluster;
 mod flat;
 mod form_factor;
@@ -274,7 +275,7 @@ impl Solution {
 }
 
 /// Rays per sample towards the sky and the ground, where daylight enters a scene.
-const SKY_RAYS: u32 = 128;
+pub(crate) const SKY_RAYS: u32 = 128;
 
 /// The largest ε a solve takes, in diagonals of the scene's bounds.
 pub const MAX_EPSILON_DIAGONALS: f32 = 100.0;
