@@ -195,6 +195,17 @@ pub fn info(scene: &Scene) -> String {
             );
         }
     }
+    if let Some(a) = scene.annual() {
+        let _ = writeln!(
+            s,
+            "annual        weather {}, occupied hours {}-{}, sky in {} patches (`meshlight \
+             annual`)",
+            a.weather.display(),
+            a.hours.0,
+            a.hours.1,
+            meshlight::daylight::patches::Patches::new(a.sky_subdivision).len()
+        );
+    }
     match scene.solver_defaults().epsilon {
         Some(e) => {
             let _ = writeln!(s, "solver        epsilon {e} (scene file)");

@@ -1040,3 +1040,78 @@ fn daylight_scenes_report_their_sky_and_a_closed_one_says_it_sees_none() {
     );
     assert!(stdout.contains("daylight factor min 0.00%"), "{stdout}");
 }
+
+#[test]
+fn annual_writes_each_points_year_and_the_grids_metrics() {
+    let out = succeed(&["info", "scenes/office/annual.toml"]);
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("occupied hours 8-18, sky in 145 patches"),
+        "{stdout}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = succeed(&[
+        "annual",
+        "scenes/office/annual.toml",
+        "--quiet",
+        "--epsilon",
+        "0.4",
+        "--hourly",
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("grid 'work plane': 80 points, 3650 occupied hours: sDA300/50%"), "{stdout}");
+    assert!(stdout.contains("GREENSBORO"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.path().join("work_plane.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("x,y,z,DA,UDI,sun_hours,exposure"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 80);
+    // A point's yearly exposure is the sum of its hours in the hourly file.
+    let hourly = std::fs::read_to_string(dir.path().join("work_plane-hourly.csv")).unwrap();
+    let mut lines = hourly.lines();
+    assert_eq!(lines.next(), Some("month,day,hour,x,y,z,E"));
+    let first = &rows[0];
+    let (mut sum, mut hours) = (0.0, 0);
+    for l in lines {
+        let v: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+        if v[3..6] == first[..3] {
+            sum += v[6];
+            hours += 1;
+        }
+    }
+    assert!(hours > 4000, "{hours}");
+    assert!((sum / first[6] - 1.0).abs() < 1e-3, "{sum} against {}", first[6]);
+    for r in &rows {
+        assert!((0.0..=100.0).contains(&r[3]) && (0.0..=100.0).contains(&r[4]), "{r:?}");
+    }
+    // A weather file cut short names itself and its last line; a scene without [annual]
+    // says what it lacks.
+    let broken = tempfile::tempdir().unwrap();
+    let text_of = |p: &str| std::fs::read_to_string(root(p)).unwrap();
+    let epw: String = text_of("scenes/office/greensboro.epw")
+        .lines()
+        .take(500)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(broken.path().join("greensboro.epw"), epw).unwrap();
+    let scene = text_of("scenes/office/annual.toml").replace(
+        "obj = \"office.obj\"",
+        &format!("obj = \"{}\"", root("scenes/office/office.obj").display()),
+    );
+    let toml = broken.path().join("annual.toml");
+    std::fs::write(&toml, scene).unwrap();
+    let out = meshlight(&["annual", toml.to_str().unwrap(), "--quiet", "-o", broken.path().to_str().unwrap()]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("greensboro.epw:500: 492 hourly rows"),
+        "{stderr}"
+    );
+    let out = meshlight(&["annual", "scenes/office/scene.toml", "--quiet"]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("has no [annual]"), "{}", text(&out.stderr));
+}

@@ -626,23 +626,27 @@ fn coefficients(
     // The sky straight in at every sample, by coarse patch (the ground last).
     let entering = Entering::of(lit, crate::solver::SKY_RAYS)
         .ok_or_else(|| Error::argument("scene", "no daylight to shoot"))?;
-    let mut escapes: Vec<Vec<Escape>> = vec![Vec::new(); n.div_ceil(256)];
+    let ground = coarse.len();
+    check_budget(lit, solution, options, coarse.len() + 1 + lattice.len())?;
+    // (patch, sample, light) of every ray that leaves, binned chunk by chunk.
+    let mut escapes: Vec<Vec<(u32, u32, Vec3)>> = vec![Vec::new(); n.div_ceil(256)];
     for_chunks(&mut escapes, 1, threads, |c, out| {
         let range = c * 256..((c + 1) * 256).min(n);
-        let (mut got, _) = entering.escapes(vis, &at[range.clone()], &ids[range.clone()], seed)?;
-        for e in &mut got {
-            e.receiver += range.start as u32;
-        }
-        out[0] = got;
+        let (got, _) = entering.escapes(vis, &at[range.clone()], &ids[range.clone()], seed)?;
+        out[0] = got
+            .iter()
+            .map(|e: &Escape| {
+                let p = frame
+                    .sky_angles(e.dir)
+                    .map_or(ground, |(alt, az)| coarse.of(alt, az));
+                (p as u32, e.receiver + range.start as u32, e.light.as_vec3())
+            })
+            .collect();
         Ok(())
     })?;
-    let ground = coarse.len();
-    let mut by_patch: Vec<Vec<(u32, DVec3)>> = vec![Vec::new(); coarse.len() + 1];
-    for e in escapes.into_iter().flatten() {
-        let p = frame
-            .sky_angles(e.dir)
-            .map_or(ground, |(alt, az)| coarse.of(alt, az));
-        by_patch[p].push((e.receiver, e.light));
+    let mut by_patch: Vec<Vec<(u32, Vec3)>> = vec![Vec::new(); coarse.len() + 1];
+    for (p, k, light) in escapes.into_iter().flatten() {
+        by_patch[p as usize].push((k, light));
     }
 
     // Each grid's light straight in (fine patches) and its gather rows.
@@ -672,7 +676,7 @@ fn coefficients(
         first.iter_mut().for_each(|f| *f = DVec3::ZERO);
         if b <= ground {
             for &(k, light) in &by_patch[b] {
-                first[k as usize] += light;
+                first[k as usize] += light.as_dvec3();
             }
         } else {
             let (altitude, azimuth) = lattice.position(b - ground - 1);
@@ -716,6 +720,44 @@ fn coefficients(
         }
     }
     Ok(Some(grids))
+}
+
+/// Bytes a sample's sky rays may hold while they are binned by patch: every one of its rays
+/// leaving (a patch, a sample and an RGB light each, twice while they are sorted).
+const ESCAPE_BYTES_PER_SAMPLE: usize = 2 * 20 * crate::solver::SKY_RAYS as usize;
+
+/// Bytes each grid point's coefficients take: one `f32` a basis, a fine patch's share of the
+/// light straight in (8 bytes each, at most one a ray), and the hours' values (8 bytes an
+/// hour, at most 8,784).
+fn point_bytes(bases: usize) -> usize {
+    4 * bases + 8 * crate::lux::GRID_SKY_RAYS as usize + 8 * 8784
+}
+
+/// Refuses a year whose coefficients would not fit what the solution leaves of the memory
+/// budget, before any is allocated.
+fn check_budget(lit: &Scene, solution: &Solution, options: &AnnualOptions, bases: usize) -> Result<()> {
+    let points: usize = lit.grids().iter().map(|g| g.points().len()).sum();
+    let samples = solution.samples.len();
+    let needed = samples * ESCAPE_BYTES_PER_SAMPLE + points * point_bytes(bases);
+    let budget = options.solver.memory_budget;
+    let left = crate::budget::usable(budget).saturating_sub(solution.bytes());
+    if needed > left {
+        return Err(crate::budget::exceeded(
+            budget,
+            format!(
+                "a year of daylight needs about {} for its coefficients ({} samples × {} bytes \
+                 of sky rays, {} grid points × {} bytes of coefficients and hours) beside the \
+                 solution's {}: raise the budget, choose a larger ε, or measure fewer points",
+                crate::budget::human_bytes(needed as f64),
+                samples,
+                ESCAPE_BYTES_PER_SAMPLE,
+                points,
+                point_bytes(bases),
+                crate::budget::human_bytes(solution.bytes() as f64)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A grid's points, which count, its light straight in from the sky and the ground (binned on
