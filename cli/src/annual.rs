@@ -18,6 +18,16 @@ pub fn run(
     options: &AnnualOptions,
     dir: &Path,
 ) -> anyhow::Result<()> {
+    year(scene, vis, options, dir).map(|_| ())
+}
+
+/// [`run`], answering the year and the lines it printed.
+pub fn year(
+    scene: &Scene,
+    vis: &dyn meshlight::Visibility,
+    options: &AnnualOptions,
+    dir: &Path,
+) -> anyhow::Result<(Year, Vec<String>)> {
     let Some(settings) = scene.annual() else {
         anyhow::bail!(
             "{}: the scene has no [annual] table naming a weather file (docs/scene-format.md, \
@@ -46,7 +56,7 @@ pub fn run(
         );
     }
     let site = &weather.site;
-    println!(
+    let mut lines = vec![format!(
         "weather {} ({}, {:.2}°, {:.2}°, UTC{:+}): {} hours with the sun up, occupied hours \
          {}-{}",
         settings.weather.display(),
@@ -57,15 +67,15 @@ pub fn run(
         year.sun_hours.len(),
         settings.hours.0,
         settings.hours.1
-    );
+    )];
     for (g, grid) in year.grids.iter().zip(scene.grids()) {
         write_grid(g, &grid.file_stem(), &year, dir, options.hourly)?;
-        println!("{}", summary(g));
+        lines.push(summary(g));
     }
     let peak = crate::memory::peak_bytes()
         .map(|b| format!(", peak memory {}", meshlight::budget::human_bytes(b as f64)))
         .unwrap_or_default();
-    println!(
+    lines.push(format!(
         "year: {} samples, {} coefficients a point ({} sky patches + ground, {} sun positions), \
          coefficients {}; weather read in {reading:.2} s, the year in {seconds:.2} s{peak}",
         year.samples,
@@ -73,12 +83,78 @@ pub fn run(
         year.bases - 1 - meshlight::annual::SUN_POSITIONS,
         meshlight::annual::SUN_POSITIONS,
         meshlight::budget::human_bytes(year.coefficient_bytes as f64),
-    );
-    Ok(())
+    ));
+    for line in &lines {
+        println!("{line}");
+    }
+    Ok((year, lines))
+}
+
+/// Each grid's plans of DA, UDI and yearly exposure: `DIR/<grid>-da.png`, `-udi.png` and
+/// `-exposure.png`.
+pub fn plans(scene: &Scene, year: &Year, dir: &Path) -> anyhow::Result<Vec<[std::path::PathBuf; 3]>> {
+    let mut out = Vec::new();
+    for (g, grid) in year.grids.iter().zip(scene.grids()) {
+        let stem = grid.file_stem();
+        let (nu, nv) = grid.counts_uv();
+        let (u, v) = grid.edges();
+        let excluded: Vec<bool> = g.metrics.iter().map(Option::is_none).collect();
+        let pick = |f: &dyn Fn(&meshlight::annual::PointYear) -> f64| -> Vec<f64> {
+            g.metrics.iter().map(|m| m.as_ref().map_or(0.0, f)).collect()
+        };
+        let s = &g.summary;
+        let maps: [(&str, Vec<f64>, &str, String, Vec<String>); 3] = [
+            (
+                "da",
+                pick(&|m| m.da),
+                "%",
+                "DA (% of occupied hours)".to_string(),
+                vec![format!("sDA300/50% {:.1}%", s.sda)],
+            ),
+            (
+                "udi",
+                pick(&|m| m.udi),
+                "%",
+                "UDI 100-3000 lx (%)".to_string(),
+                vec![format!("ASE1000,250h {:.1}%", s.ase)],
+            ),
+            (
+                "exposure",
+                pick(&|m| m.exposure / 1000.0),
+                "klx·h",
+                "exposure (klx·h a year)".to_string(),
+                vec![format!("largest {:.0} klx·h", s.max_exposure / 1000.0)],
+            ),
+        ];
+        let mut paths = Vec::new();
+        for (suffix, values, unit, title, caption) in &maps {
+            let path = dir.join(format!("{stem}-{suffix}.png"));
+            crate::plan::plan_png(
+                &path,
+                &crate::plan::Plan {
+                    counts: (nu, nv),
+                    values,
+                    excluded: &excluded,
+                    spacing: (
+                        f64::from(u.length()) / f64::from(nu),
+                        f64::from(v.length()) / f64::from(nv),
+                    ),
+                    marks: &[],
+                    outline: &crate::lux::cut(scene, grid),
+                    unit,
+                    title,
+                    caption,
+                },
+            )?;
+            paths.push(path);
+        }
+        out.push([paths[0].clone(), paths[1].clone(), paths[2].clone()]);
+    }
+    Ok(out)
 }
 
 /// A grid's line: sDA, ASE, EN 17037 and the largest exposure.
-fn summary(g: &meshlight::annual::GridYear) -> String {
+pub fn summary(g: &meshlight::annual::GridYear) -> String {
     let s = &g.summary;
     format!(
         "grid '{}': {} points, {} occupied hours: sDA300/50% {:.1}%, ASE1000,250h {:.1}%, \
@@ -93,7 +169,12 @@ fn summary(g: &meshlight::annual::GridYear) -> String {
         s.daylight_hours,
         if s.en17037_met { "met" } else { "not met" },
         s.max_exposure
-    )
+    ) + &match meshlight::annual::metrics::cie157_class(s.max_exposure) {
+        Some(class) => format!(
+            " (within CIE 157's yearly limit for {class}-responsivity objects)"
+        ),
+        None => " (beyond CIE 157's yearly limits: for light-irresponsive objects only)".into(),
+    }
 }
 
 /// `DIR/<name>.csv` (and the hourly CSV).

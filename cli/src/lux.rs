@@ -334,7 +334,7 @@ fn lights_over(scene: &Scene, grid: &meshlight::scene::Grid) -> Vec<(f64, f64)> 
 
 /// The scene's triangles cut by a grid's plane, as segments in its coordinates (point (i, j)
 /// at (i, j)): what a plan draws of walls and furniture.
-fn cut(scene: &Scene, grid: &meshlight::scene::Grid) -> Vec<[(f64, f64); 2]> {
+pub fn cut(scene: &Scene, grid: &meshlight::scene::Grid) -> Vec<[(f64, f64); 2]> {
     let (nu, nv) = grid.counts_uv();
     let (u, v) = grid.edges();
     let n = u.cross(v).normalize_or_zero();

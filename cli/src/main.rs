@@ -193,6 +193,16 @@ fn report_command(
     loading: &LoadOptions,
 ) -> anyhow::Result<()> {
     let (scene, options) = solve_setup(solve, loading)?;
+    // A year's scene without a sky of its own: its grids and view under the daylight
+    // factor's sky, the CIE overcast.
+    let scene = match (scene.annual(), scene.daylight()) {
+        (Some(annual), None) => {
+            let mut overcast = scene.clone();
+            overcast.set_daylight(Some(annual.overcast()?));
+            overcast
+        }
+        _ => scene,
+    };
     let vis = backend_from(&solve.knobs).build(&scene)?;
     diagnose(&scene, vis.as_ref())?;
     let t = std::time::Instant::now();
@@ -224,10 +234,27 @@ fn report_command(
     false_colour_render(&image, &false_path, luminance, None, false, scene.units())?;
     let views = vec![std::fs::read(&view_path)?, std::fs::read(&false_path)?];
     let rendering = t.elapsed().as_secs_f64();
+    let annual = match scene.annual() {
+        Some(_) => {
+            let year_options = meshlight::annual::AnnualOptions {
+                lux: meshlight::lux::LuxOptions {
+                    light_samples: light_samples.clamp(1, 16),
+                    ..lux_options
+                },
+                solver: options.clone(),
+                hourly: false,
+            };
+            let (year, lines) = annual::year(&scene, vis.as_ref(), &year_options, output)?;
+            let plans = annual::plans(&scene, &year, output)?;
+            Some(page::AnnualPage { lines, year, plans })
+        }
+        None => None,
+    };
     let extras = page::Extras {
         views,
         summary: &summary,
         seconds: (solving, measuring, rendering),
+        annual,
     };
     let path = page::write(output, &scene, &solution, &grids, &extras)?;
     println!("wrote {}", path.display());

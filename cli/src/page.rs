@@ -22,6 +22,18 @@ pub struct Extras<'a> {
     pub summary: &'a str,
     /// Seconds the solve, the grids and the view took.
     pub seconds: (f64, f64, f64),
+    /// A year of weather, where the scene has `[annual]`.
+    pub annual: Option<AnnualPage>,
+}
+
+/// A year of weather as the page shows it.
+pub struct AnnualPage {
+    /// The lines `meshlight annual` printed (the weather first).
+    pub lines: Vec<String>,
+    /// The year.
+    pub year: meshlight::annual::Year,
+    /// Per grid, its DA, UDI and exposure plans.
+    pub plans: Vec<[std::path::PathBuf; 3]>,
 }
 
 /// Writes `DIR/index.html`; answers its path.
@@ -211,6 +223,10 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
         writeln!(h, "</section>")?;
     }
 
+    if let Some(annual) = &extras.annual {
+        annual_section(&mut h, annual)?;
+    }
+
     // Plans.
     writeln!(h, "<section id=\"plans\"><h2>Isolux plans</h2>")?;
     for g in grids {
@@ -261,6 +277,76 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
     )?;
     writeln!(h, "</body>\n</html>")?;
     Ok(h)
+}
+
+/// The year: the weather, each grid's climate-based metrics and verdicts, and its plans.
+fn annual_section(h: &mut String, annual: &AnnualPage) -> Result<()> {
+    use meshlight::annual::metrics::cie157_class;
+    writeln!(
+        h,
+        "<section id=\"annual\"><h2>A year of daylight</h2><p>{}</p>",
+        escape(annual.lines.first().map_or("", String::as_str))
+    )?;
+    writeln!(
+        h,
+        "<table id=\"annual-table\"><thead><tr><th>grid</th><th>points</th>\
+         <th>sDA300/50%</th><th>ASE1000,250h</th><th>EN 17037 (300 lx, half the grid, half \
+         the daylight hours)</th><th>largest exposure (lx·h a year)</th><th>CIE 157</th>\
+         </tr></thead><tbody>"
+    )?;
+    for g in &annual.year.grids {
+        let s = &g.summary;
+        let (class, verdict) = if s.en17037_met {
+            ("pass", format!("met ({:.1}% of {} hours)", s.en17037_hours, s.daylight_hours))
+        } else {
+            ("fail", format!("not met ({:.1}% of {} hours)", s.en17037_hours, s.daylight_hours))
+        };
+        let cie = match cie157_class(s.max_exposure) {
+            Some(c) => format!("within the limit for {c}-responsivity objects"),
+            None => "beyond every limit: light-irresponsive objects only".to_string(),
+        };
+        writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{:.1}%</td><td>{:.1}%</td><td class=\"{class}\">{}</td>\
+             <td>{}</td><td>{}</td></tr>",
+            escape(&g.name),
+            s.points,
+            s.sda,
+            s.ase,
+            verdict,
+            round_label(s.max_exposure),
+            cie
+        )?;
+    }
+    writeln!(
+        h,
+        "</tbody></table><p>DA: the share of occupied hours a point reaches its target (300 lx \
+         unless the grid sets <code>target_em</code>); sDA: the share of points with DA ≥ 50% \
+         (IES LM-83); ASE: the share of points with more than 250 occupied hours of direct sun \
+         ≥ 1000 lx; UDI: the share of occupied hours within 100-3000 lx; exposure: lux-hours \
+         over the whole year, against CIE 157's limits of 15,000 (high responsivity), 150,000 \
+         (medium) and 600,000 lx·h (low).</p>"
+    )?;
+    let captions = [
+        "daylight autonomy (% of occupied hours)",
+        "useful daylight illuminance 100-3000 lx (% of occupied hours)",
+        "yearly exposure (klx·h)",
+    ];
+    for (g, plans) in annual.year.grids.iter().zip(&annual.plans) {
+        for (path, caption) in plans.iter().zip(captions) {
+            let png =
+                std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+            writeln!(
+                h,
+                "<figure><img alt=\"{caption} of {n}\" src=\"data:image/png;base64,{}\">\
+                 <figcaption>{n}: {caption}</figcaption></figure>",
+                base64(&png),
+                n = escape(&g.name)
+            )?;
+        }
+    }
+    writeln!(h, "</section>")?;
+    Ok(())
 }
 
 const STYLE: &str =

@@ -1088,6 +1088,24 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
     for r in &rows {
         assert!((0.0..=100.0).contains(&r[3]) && (0.0..=100.0).contains(&r[4]), "{r:?}");
     }
+    // The report shows the year: its metrics table and plans.
+    let page = dir.path().join("report");
+    succeed(&[
+        "report",
+        "scenes/office/annual.toml",
+        "--quiet",
+        "--epsilon",
+        "0.4",
+        "-o",
+        page.to_str().unwrap(),
+    ]);
+    let html = std::fs::read_to_string(page.join("index.html")).unwrap();
+    assert!(html.contains("<h2>A year of daylight</h2>"), "no annual section");
+    assert!(html.contains("id=\"annual-table\""));
+    assert!(html.contains("work plane: daylight autonomy"));
+    // Without a sky of its own the one-moment grids are under the overcast sky: a daylight
+    // factor.
+    assert!(html.contains("<h2>Daylight factor</h2>"));
     // A weather file cut short names itself and its last line; a scene without [annual]
     // says what it lacks.
     let broken = tempfile::tempdir().unwrap();

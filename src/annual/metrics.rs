@@ -17,6 +17,23 @@ pub const ASE_HOURS: u32 = 250;
 /// EN 17037's target illuminance (lx), over half the grid for half the daylight hours.
 pub const EN17037_TARGET: f64 = 300.0;
 
+/// CIE 157:2004's limiting annual exposures for museum objects (lx·h a year), by their
+/// responsivity to light, most responsive first; irresponsive objects have none.
+pub const CIE157_LIMITS: [(&str, f64); 3] = [
+    ("high", 15_000.0),
+    ("medium", 150_000.0),
+    ("low", 600_000.0),
+];
+
+/// The most light-responsive class of museum object (CIE 157) whose yearly limit `exposure`
+/// (lx·h) stays within; `None` beyond every limit (irresponsive objects only).
+pub fn cie157_class(exposure: f64) -> Option<&'static str> {
+    CIE157_LIMITS
+        .iter()
+        .find(|(_, limit)| exposure <= *limit)
+        .map(|(class, _)| *class)
+}
+
 /// What a year gives one point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[non_exhaustive]
@@ -186,5 +203,13 @@ mod tests {
         assert_eq!(s.en17037_hours, 62.5);
         assert!(s.en17037_met);
         assert_eq!(s.max_exposure, 40_000.0 + 6.0 * 200.0);
+    }
+
+    #[test]
+    fn cie_157_classes_follow_its_limits() {
+        assert_eq!(cie157_class(15_000.0), Some("high"));
+        assert_eq!(cie157_class(15_001.0), Some("medium"));
+        assert_eq!(cie157_class(600_000.0), Some("low"));
+        assert_eq!(cie157_class(600_001.0), None);
     }
 }

@@ -28,7 +28,7 @@ use crate::daylight::entering::{Entering, Escape};
 use crate::daylight::epw::Weather;
 use crate::daylight::patches::Patches;
 use crate::daylight::spa::{delta_t, sun_position, LocalTime, Observer};
-use crate::daylight::{AnnualSettings, Daylight, Sky, SkyModel};
+use crate::daylight::{AnnualSettings, Sky, SkyModel};
 use crate::error::{Error, Result};
 use crate::light::DirectLight;
 use crate::lux::LuxOptions;
@@ -375,17 +375,8 @@ fn run(
     let hours = hours(weather, &frame, settings);
 
     // The solve, under an overcast sky: samples, areas, links, row scales.
-    let overcast = Daylight::new(
-        Sky::new(SkyModel::CieOvercast, 0.0, 0.0, 10_000.0)?,
-        site.up,
-        site.north,
-        frame.ground_reflectance,
-        10_000.0,
-        None,
-        0.0,
-    )?;
     let mut lit = scene.clone();
-    lit.set_daylight(Some(overcast));
+    lit.set_daylight(Some(settings.overcast()?));
     let lit = &lit;
     let solution = crate::solver::solve(lit, vis, &options.solver, &mut *progress)?;
     let mut year = Year {

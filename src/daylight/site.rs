@@ -50,6 +50,22 @@ pub struct AnnualSettings {
     pub site: Site,
 }
 
+impl AnnualSettings {
+    /// The CIE overcast sky of 10,000 lx over this site, without sun: the daylight factor's
+    /// sky, under which a year's solve places its samples.
+    pub fn overcast(&self) -> Result<Daylight> {
+        Daylight::new(
+            Sky::new(super::SkyModel::CieOvercast, 0.0, 0.0, 10_000.0)?,
+            self.site.up,
+            self.site.north,
+            self.site.ground_reflectance,
+            10_000.0,
+            None,
+            0.0,
+        )
+    }
+}
+
 /// The daylight outside a scene: what a ray leaving the model sees.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Daylight {
