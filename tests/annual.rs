@@ -28,7 +28,10 @@ fn office_weather() -> Weather {
 fn the_typical_year_reads_as_its_tmy3_source_says() {
     let w = office_weather();
     assert_eq!(w.hours.len(), 8760);
-    assert_eq!((w.site.latitude, w.site.longitude, w.site.timezone), (36.1, -79.95, -5.0));
+    assert_eq!(
+        (w.site.latitude, w.site.longitude, w.site.timezone),
+        (36.1, -79.95, -5.0)
+    );
     // NREL's TMY3 row "06/16/1989,14:00": DNI 1 W/m², DHI 292 W/m², DN illuminance 1 and DH
     // 354 in its units of 100 lx.
     let h = w
@@ -37,7 +40,10 @@ fn the_typical_year_reads_as_its_tmy3_source_says() {
         .find(|h| (h.month, h.day, h.hour) == (6, 16, 14))
         .unwrap();
     assert_eq!(h.year, 1989);
-    assert_eq!((h.direct_normal_w, h.diffuse_horizontal_w), (Some(1.0), Some(292.0)));
+    assert_eq!(
+        (h.direct_normal_w, h.diffuse_horizontal_w),
+        (Some(1.0), Some(292.0))
+    );
     assert_eq!(
         (h.direct_normal_lx, h.diffuse_horizontal_lx),
         (Some(100.0), Some(35_400.0))
@@ -87,7 +93,11 @@ fn a_synthetic_year_gives_the_metrics_counted_by_hand() {
         if !(9..=18).contains(&h) {
             return (0.0, 0.0);
         }
-        let dn = if d % 10 == 0 && h == 13 { 100_000.0 } else { 0.0 };
+        let dn = if d % 10 == 0 && h == 13 {
+            100_000.0
+        } else {
+            0.0
+        };
         (dn, sky[(d % 4) as usize])
     };
     let weather = synthetic_year(light);
@@ -169,8 +179,18 @@ fn a_synthetic_year_gives_the_metrics_counted_by_hand() {
         assert_eq!(g.summary.occupied_hours, 3650);
         assert_eq!(g.summary.daylight_hours, 3650);
         for m in g.metrics.iter().map(|m| m.unwrap()) {
-            assert_eq!(m.da, 100.0 * f64::from(above) / 3650.0, "{}", backend.name());
-            assert_eq!(m.udi, 100.0 * f64::from(useful) / 3650.0, "{}", backend.name());
+            assert_eq!(
+                m.da,
+                100.0 * f64::from(above) / 3650.0,
+                "{}",
+                backend.name()
+            );
+            assert_eq!(
+                m.udi,
+                100.0 * f64::from(useful) / 3650.0,
+                "{}",
+                backend.name()
+            );
             assert_eq!(m.sun_hours, sun, "{}", backend.name());
             assert!(
                 (m.exposure / exposure - 1.0).abs() < 0.005,
@@ -197,7 +217,10 @@ fn office_at(weather: &Weather, h: &meshlight::daylight::epw::WeatherHour) -> Sc
     let text = std::fs::read_to_string(dir.join("annual.toml")).unwrap();
     let (head, tail) = text.split_once("[annual]").unwrap();
     let grids = &tail[tail.find("[[grid]]").unwrap()..];
-    let (dn, dh) = (h.direct_normal_lx.unwrap(), h.diffuse_horizontal_lx.unwrap());
+    let (dn, dh) = (
+        h.direct_normal_lx.unwrap(),
+        h.diffuse_horizontal_lx.unwrap(),
+    );
     let head = head.replace(
         "[site]",
         &format!(
@@ -265,10 +288,9 @@ fn the_office_year_matches_one_moment_solves_hour_by_hour() {
                 .unwrap();
             let moment = office_at(&weather, h);
             let vis1 = backend.build(&moment).unwrap();
-            let solution = meshlight::solve(&moment, vis1.as_ref(), &solver, &mut |_| {
-                Control::Continue
-            })
-            .unwrap();
+            let solution =
+                meshlight::solve(&moment, vis1.as_ref(), &solver, &mut |_| Control::Continue)
+                    .unwrap();
             let e = illuminance(
                 &moment,
                 &solution,
@@ -311,7 +333,10 @@ fn the_office_year_matches_one_moment_solves_hour_by_hour() {
             sun_in += usize::from(one.iter().any(|&v| v > 3.0 * mean(&one)));
         }
         // The hours span clear and overcast skies, the sun in and out of the window.
-        assert!(clear >= 3 && overcast >= 3 && sun_in >= 2 && sun_in < 20, "{clear} {overcast} {sun_in}");
+        assert!(
+            clear >= 3 && overcast >= 3 && sun_in >= 2 && sun_in < 20,
+            "{clear} {overcast} {sun_in}"
+        );
         eprintln!(
             "{}: worst mean {:.2}%, worst point {:.2}% over 20 hours",
             backend.name(),

@@ -92,7 +92,11 @@ pub fn year(
 
 /// Each grid's plans of DA, UDI and yearly exposure: `DIR/<grid>-da.png`, `-udi.png` and
 /// `-exposure.png`.
-pub fn plans(scene: &Scene, year: &Year, dir: &Path) -> anyhow::Result<Vec<[std::path::PathBuf; 3]>> {
+pub fn plans(
+    scene: &Scene,
+    year: &Year,
+    dir: &Path,
+) -> anyhow::Result<Vec<[std::path::PathBuf; 3]>> {
     let mut out = Vec::new();
     for (g, grid) in year.grids.iter().zip(scene.grids()) {
         let stem = grid.file_stem();
@@ -100,7 +104,10 @@ pub fn plans(scene: &Scene, year: &Year, dir: &Path) -> anyhow::Result<Vec<[std:
         let (u, v) = grid.edges();
         let excluded: Vec<bool> = g.metrics.iter().map(Option::is_none).collect();
         let pick = |f: &dyn Fn(&meshlight::annual::PointYear) -> f64| -> Vec<f64> {
-            g.metrics.iter().map(|m| m.as_ref().map_or(0.0, f)).collect()
+            g.metrics
+                .iter()
+                .map(|m| m.as_ref().map_or(0.0, f))
+                .collect()
         };
         let s = &g.summary;
         let maps: [(&str, Vec<f64>, &str, String, Vec<String>); 3] = [
@@ -170,9 +177,7 @@ pub fn summary(g: &meshlight::annual::GridYear) -> String {
         if s.en17037_met { "met" } else { "not met" },
         s.max_exposure
     ) + &match meshlight::annual::metrics::cie157_class(s.max_exposure) {
-        Some(class) => format!(
-            " (within CIE 157's yearly limit for {class}-responsivity objects)"
-        ),
+        Some(class) => format!(" (within CIE 157's yearly limit for {class}-responsivity objects)"),
         None => " (beyond CIE 157's yearly limits: for light-irresponsive objects only)".into(),
     }
 }

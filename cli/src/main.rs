@@ -1,9 +1,9 @@
 //! The `meshlight` command: parses arguments, calls the library, reports. Nothing else.
 
+mod annual;
 mod args;
 mod bench;
 mod errors;
-mod annual;
 mod lux;
 mod memory;
 mod page;

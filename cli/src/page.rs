@@ -297,9 +297,21 @@ fn annual_section(h: &mut String, annual: &AnnualPage) -> Result<()> {
     for g in &annual.year.grids {
         let s = &g.summary;
         let (class, verdict) = if s.en17037_met {
-            ("pass", format!("met ({:.1}% of {} hours)", s.en17037_hours, s.daylight_hours))
+            (
+                "pass",
+                format!(
+                    "met ({:.1}% of {} hours)",
+                    s.en17037_hours, s.daylight_hours
+                ),
+            )
         } else {
-            ("fail", format!("not met ({:.1}% of {} hours)", s.en17037_hours, s.daylight_hours))
+            (
+                "fail",
+                format!(
+                    "not met ({:.1}% of {} hours)",
+                    s.en17037_hours, s.daylight_hours
+                ),
+            )
         };
         let cie = match cie157_class(s.max_exposure) {
             Some(c) => format!("within the limit for {c}-responsivity objects"),

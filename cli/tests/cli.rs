@@ -1061,7 +1061,10 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
         dir.path().to_str().unwrap(),
     ]);
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("grid 'work plane': 80 points, 3650 occupied hours: sDA300/50%"), "{stdout}");
+    assert!(
+        stdout.contains("grid 'work plane': 80 points, 3650 occupied hours: sDA300/50%"),
+        "{stdout}"
+    );
     assert!(stdout.contains("GREENSBORO"), "{stdout}");
     let csv = std::fs::read_to_string(dir.path().join("work_plane.csv")).unwrap();
     let mut lines = csv.lines();
@@ -1084,9 +1087,16 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
         }
     }
     assert!(hours > 4000, "{hours}");
-    assert!((sum / first[6] - 1.0).abs() < 1e-3, "{sum} against {}", first[6]);
+    assert!(
+        (sum / first[6] - 1.0).abs() < 1e-3,
+        "{sum} against {}",
+        first[6]
+    );
     for r in &rows {
-        assert!((0.0..=100.0).contains(&r[3]) && (0.0..=100.0).contains(&r[4]), "{r:?}");
+        assert!(
+            (0.0..=100.0).contains(&r[3]) && (0.0..=100.0).contains(&r[4]),
+            "{r:?}"
+        );
     }
     // The report shows the year: its metrics table and plans.
     let page = dir.path().join("report");
@@ -1100,7 +1110,10 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
         page.to_str().unwrap(),
     ]);
     let html = std::fs::read_to_string(page.join("index.html")).unwrap();
-    assert!(html.contains("<h2>A year of daylight</h2>"), "no annual section");
+    assert!(
+        html.contains("<h2>A year of daylight</h2>"),
+        "no annual section"
+    );
     assert!(html.contains("id=\"annual-table\""));
     assert!(html.contains("work plane: daylight autonomy"));
     // Without a sky of its own the one-moment grids are under the overcast sky: a daylight
@@ -1122,7 +1135,13 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
     );
     let toml = broken.path().join("annual.toml");
     std::fs::write(&toml, scene).unwrap();
-    let out = meshlight(&["annual", toml.to_str().unwrap(), "--quiet", "-o", broken.path().to_str().unwrap()]);
+    let out = meshlight(&[
+        "annual",
+        toml.to_str().unwrap(),
+        "--quiet",
+        "-o",
+        broken.path().to_str().unwrap(),
+    ]);
     assert!(!out.status.success());
     let stderr = text(&out.stderr);
     assert!(
@@ -1131,5 +1150,9 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
     );
     let out = meshlight(&["annual", "scenes/office/scene.toml", "--quiet"]);
     assert!(!out.status.success());
-    assert!(text(&out.stderr).contains("has no [annual]"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("has no [annual]"),
+        "{}",
+        text(&out.stderr)
+    );
 }

@@ -147,7 +147,8 @@ impl Tally {
             .collect();
         let counted: Vec<PointYear> = points.iter().flatten().copied().collect();
         let n = counted.len() as u32;
-        let share = |f: &dyn Fn(&PointYear) -> bool| pct(counted.iter().filter(|p| f(p)).count() as u32, n);
+        let share =
+            |f: &dyn Fn(&PointYear) -> bool| pct(counted.iter().filter(|p| f(p)).count() as u32, n);
         let en17037_hours = pct(self.en17037, self.daylight);
         let summary = GridSummary {
             points: counted.len(),

@@ -38,8 +38,8 @@ use crate::scene::{luminance, Grid, Scene};
 use crate::solver::basis::Basis;
 use crate::solver::{Options, Solution, StopReason};
 use crate::visibility::Visibility;
-pub use metrics::{GridSummary, PointYear};
 use metrics::Tally;
+pub use metrics::{GridSummary, PointYear};
 use suns::SunLattice;
 
 /// Sun positions whose inter-reflected light is shot (the lattice's nodes, those below the
@@ -566,10 +566,11 @@ fn hour_values(
                 .sum::<f64>();
             v += f64::from(bounced[coarse.len()]) * ground;
             let suns = &g.sun_bounced[i * lattice.len()..(i + 1) * lattice.len()];
-            v += dn * around
-                .iter()
-                .map(|&(node, w)| w * f64::from(suns[node]))
-                .sum::<f64>();
+            v += dn
+                * around
+                    .iter()
+                    .map(|&(node, w)| w * f64::from(suns[node]))
+                    .sum::<f64>();
             e.push(v as f32);
         }
         out.push((e, sun_direct.iter().map(|&s| s as f32).collect()));
@@ -646,8 +647,15 @@ fn coefficients(
     let mut grids = Vec::new();
     let mut rows = Vec::new();
     for grid in lit.grids() {
-        let (coefficients, gather) =
-            grid_coefficients(lit, solution, vis, grid, &grid_entering, (frame, fine), options)?;
+        let (coefficients, gather) = grid_coefficients(
+            lit,
+            solution,
+            vis,
+            grid,
+            &grid_entering,
+            (frame, fine),
+            options,
+        )?;
         grids.push(GridNamed {
             name: grid.name().to_string(),
             coefficients: GridCoefficients {
@@ -660,7 +668,10 @@ fn coefficients(
     }
 
     // Shoot each basis; keep what reaches the grid points.
-    let shooter = Basis::new(lit, solution, vis, &options.solver);
+    let mut stop = || reporter.stopped();
+    let Some(mut shooter) = Basis::new(lit, solution, vis, &options.solver, &mut stop)? else {
+        return Ok(None);
+    };
     let mut sun = DirectLight::unit_sun(lit, options.solver.light_samples, Vec3::Y);
     let mut first = vec![DVec3::ZERO; n];
     for b in 0..bases {
@@ -726,7 +737,12 @@ fn point_bytes(bases: usize) -> usize {
 
 /// Refuses a year whose coefficients would not fit what the solution leaves of the memory
 /// budget, before any is allocated.
-fn check_budget(lit: &Scene, solution: &Solution, options: &AnnualOptions, bases: usize) -> Result<()> {
+fn check_budget(
+    lit: &Scene,
+    solution: &Solution,
+    options: &AnnualOptions,
+    bases: usize,
+) -> Result<()> {
     let points: usize = lit.grids().iter().map(|g| g.points().len()).sum();
     let samples = solution.samples.len();
     let needed = samples * ESCAPE_BYTES_PER_SAMPLE + points * point_bytes(bases);
@@ -771,7 +787,8 @@ fn grid_coefficients(
     let mut direct: Vec<Vec<(u32, f32)>> = vec![Vec::new(); points.len()];
     for_chunks(&mut direct, 8, threads, |first, out| {
         let range = first..first + out.len();
-        let (escapes, _) = entering.escapes(vis, &at[range.clone()], &ids[range], options.lux.seed)?;
+        let (escapes, _) =
+            entering.escapes(vis, &at[range.clone()], &ids[range], options.lux.seed)?;
         let mut bins: Vec<std::collections::BTreeMap<u32, f64>> =
             vec![Default::default(); out.len()];
         for e in escapes {

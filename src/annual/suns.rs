@@ -121,7 +121,11 @@ mod tests {
         // Mornings are east.
         let (_, az) = horizontal(52.0, 0.0, -45.0);
         assert!(az > 90.0 && az < 180.0, "{az}");
-        for (lat, d, h) in [(52.0, 10.0, -60.0), (-33.0, -20.0, 75.0), (5.0, 23.0, 150.0)] {
+        for (lat, d, h) in [
+            (52.0, 10.0, -60.0),
+            (-33.0, -20.0, 75.0),
+            (5.0, 23.0, 150.0),
+        ] {
             let (alt, az) = horizontal(lat, d, h);
             let (d2, h2) = equatorial(lat, alt, az);
             assert!((d - d2).abs() < 1e-9 && (h - h2).abs() < 1e-9, "{d2} {h2}");

@@ -234,7 +234,8 @@ fn row(line: &str) -> std::result::Result<WeatherHour, String> {
     let diffuse_horizontal_w = value(15, "diffuse horizontal radiation", MISSING_IRRADIANCE)?;
     let global_lx = value(16, "global horizontal illuminance", MISSING_ILLUMINANCE)?;
     let mut direct_normal_lx = value(17, "direct normal illuminance", MISSING_ILLUMINANCE)?;
-    let mut diffuse_horizontal_lx = value(18, "diffuse horizontal illuminance", MISSING_ILLUMINANCE)?;
+    let mut diffuse_horizontal_lx =
+        value(18, "diffuse horizontal illuminance", MISSING_ILLUMINANCE)?;
     // Illuminances all 0 while the irradiances say there is light: the file has none.
     let lit = direct_normal_w.unwrap_or(0.0) > 0.0 || diffuse_horizontal_w.unwrap_or(0.0) > 0.0;
     let unlit = [global_lx, direct_normal_lx, diffuse_horizontal_lx]
@@ -330,14 +331,26 @@ mod tests {
     fn malformed_files_name_the_line() {
         let good = year(false, plain);
         let cases: Vec<(String, usize, &str)> = vec![
-            (good.replacen("2023,1,1,5,", "2023,1,1,25,", 1), 13, "hour 25"),
-            (good.replacen("2023,2,28,1,", "2023,2,29,1,", 1), 8 + 58 * 24 + 1, "day 29"),
+            (
+                good.replacen("2023,1,1,5,", "2023,1,1,25,", 1),
+                13,
+                "hour 25",
+            ),
+            (
+                good.replacen("2023,2,28,1,", "2023,2,29,1,", 1),
+                8 + 58 * 24 + 1,
+                "day 29",
+            ),
             (
                 good.replacen(",500,100,40000", ",500,-3,40000", 1),
                 9,
                 "diffuse horizontal radiation",
             ),
-            (good.replacen("2023,1,1,2,60,", "2023,1,1,2,60\n", 1), 10, "fields"),
+            (
+                good.replacen("2023,1,1,2,60,", "2023,1,1,2,60\n", 1),
+                10,
+                "fields",
+            ),
             (good.replace("LOCATION,", "PLACE,"), 1, "LOCATION"),
             (
                 good.replace("52.37,4.90", "north,4.90"),

@@ -42,11 +42,7 @@ impl Patches {
                 n * TREGENZA[(r / n) as usize]
             };
             let low = f64::from(r) * height;
-            let high = if r == 7 * n {
-                90.0
-            } else {
-                low + height
-            };
+            let high = if r == 7 * n { 90.0 } else { low + height };
             rows.push(Row {
                 low,
                 high,

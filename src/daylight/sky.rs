@@ -359,7 +359,6 @@ impl Sky {
         })
     }
 
-
     /// The model.
     pub fn model(&self) -> SkyModel {
         self.model

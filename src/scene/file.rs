@@ -407,7 +407,9 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
     let annual = match parsed.annual {
         Some(a) => {
             let span = a.span();
-            Some(annual(dir, site, a.into_inner(), &|p| at(span.clone(), format!("[annual] {p}")))?)
+            Some(annual(dir, site, a.into_inner(), &|p| {
+                at(span.clone(), format!("[annual] {p}"))
+            })?)
         }
         None => None,
     };
@@ -539,8 +541,6 @@ fn local_time(text: &str, timezone: f64) -> std::result::Result<LocalTime, Strin
         timezone,
     })
 }
-
-
 
 /// `[site]`, checked: its keys within their ranges; errors name the table's line.
 fn site(
@@ -687,7 +687,12 @@ fn daylight(
             };
             let year = f64::from(time.year) + (f64::from(time.month) - 0.5) / 12.0;
             let sun = sun_position(&time, &observer, crate::daylight::spa::delta_t(year));
-            (Some((sun.zenith, sun.azimuth)), Some(crate::daylight::day_of_year(time.year, time.month, time.day)))
+            (
+                Some((sun.zenith, sun.azimuth)),
+                Some(crate::daylight::day_of_year(
+                    time.year, time.month, time.day,
+                )),
+            )
         }
         (None, Some(alt), Some(az)) => {
             if !((-90.0..=90.0).contains(&alt) && az.is_finite()) {

@@ -147,7 +147,9 @@ pub(crate) fn shoot(
         stats.bytes = link_bytes as u64;
         return Ok(stats);
     }
-    let groups = sweep(state, &tree, groups, &counts, settings, &mut stats, report)?;
+    let (groups, _) = sweep(
+        state, &tree, groups, &counts, settings, &mut stats, report, None,
+    )?;
     let delivered: usize = groups
         .iter()
         .map(|g| g.delivered.capacity() * std::mem::size_of::<DVec3>())
@@ -156,6 +158,112 @@ pub(crate) fn shoot(
         + delivered
         + tree.nodes.len() * (std::mem::size_of::<tree::Node>() + std::mem::size_of::<Shooter>()))
         as u64;
+    Ok(stats)
+}
+
+/// One tree and its links with their row sums, kept to shoot many lightings of the same
+/// samples (`solver::basis`): sweeps only, no linking, for each.
+pub(crate) struct Linked {
+    tree: Tree,
+    groups: Vec<Group>,
+    counts: Vec<usize>,
+    /// Each receiver's normalised row sum, for the sweeps' balance (empty: none needed).
+    rows: Vec<f64>,
+    links: u64,
+    leaf_links: u64,
+}
+
+/// Builds the tree and links for `state`'s samples, its shooters weighed by
+/// `state.radiosity`, and their row sums and scales (into `state.row_scale`); `None` if the
+/// host stopped. One process only.
+pub(crate) fn link(
+    state: &mut State,
+    vis: &dyn Visibility,
+    settings: &Settings,
+    cx: &Context,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<Option<Linked>> {
+    let samples = state.samples;
+    let n = samples.len();
+    let mut stats = ShootStats::new();
+    let (weight, reference) = shooter_weights(state);
+    let rho: Vec<f32> = state
+        .reflectance
+        .iter()
+        .map(|r| r.max_element() as f32)
+        .collect();
+    let tree = Tree::build(samples, &rho, &weight, cx);
+    let roots = tree.cut(group_size(n));
+    let linker = Linker {
+        tree: &tree,
+        samples,
+        maps: state.maps,
+        vis,
+        lift: settings.lift,
+        tolerance: settings.threshold * reference,
+        faint_links: !settings.exact_visibility,
+        seed: settings.seed,
+        halt: &std::sync::atomic::AtomicBool::new(false),
+    };
+    let (groups, flow) = link_groups(&linker, &roots, settings, &mut stats, report)?;
+    if flow.is_break() {
+        return Ok(None);
+    }
+    let all = || groups.iter().flat_map(|g| &g.links);
+    stats.links = all().map(|l| (l.leaf.len() + l.cluster.len()) as u64).sum();
+    stats.leaf_links = all().map(|l| l.leaf.len() as u64).sum();
+    let counts = vec![3 * n];
+    // The row sums alone: a sweep budget of none.
+    let rows_only = Settings {
+        normalise: true,
+        max_shots: 0,
+        ..*settings
+    };
+    let (groups, rows) = sweep(
+        state, &tree, groups, &counts, &rows_only, &mut stats, report, None,
+    )?;
+    Ok(Some(Linked {
+        tree,
+        groups,
+        counts,
+        rows,
+        links: stats.links,
+        leaf_links: stats.leaf_links,
+    }))
+}
+
+/// Shoots `state` along `linked`'s links until converged (the row scales in `state` are those
+/// the linking found).
+pub(crate) fn shoot_along(
+    state: &mut State,
+    linked: &mut Linked,
+    settings: &Settings,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<ShootStats> {
+    if let Some(stats) = nothing_to_shoot(state) {
+        return Ok(stats);
+    }
+    let mut stats = ShootStats::new();
+    stats.links = linked.links;
+    stats.leaf_links = linked.leaf_links;
+    let settings = Settings {
+        normalise: false,
+        ..*settings
+    };
+    let groups = std::mem::take(&mut linked.groups);
+    let rows = std::mem::take(&mut linked.rows);
+    let (groups, _) = sweep(
+        state,
+        &linked.tree,
+        groups,
+        &linked.counts,
+        &settings,
+        &mut stats,
+        report,
+        Some(&rows),
+    )?;
+    linked.groups = groups;
+    linked.rows = rows;
     Ok(stats)
 }
 
@@ -337,7 +445,9 @@ fn share_groups(ranks: &dyn Ranks, parts: &[Vec<(u32, Links)>]) -> Result<Vec<us
 
 /// The row sums (one sweep with unit radiosity, when asked), then sweeps until the unshot
 /// power is below the tolerance, the sweeps run out, or the host stops; the groups back.
-/// `counts`: what each rank gives to a sweep's exchange.
+/// `counts`: what each rank gives to a sweep's exchange. `given`: row sums found before (for
+/// the balance), where the sweeps do not find them; the groups and the row sums back.
+#[allow(clippy::too_many_arguments)]
 fn sweep(
     state: &mut State,
     tree: &Tree,
@@ -346,7 +456,8 @@ fn sweep(
     settings: &Settings,
     stats: &mut ShootStats,
     report: &mut dyn FnMut(Tick) -> Control,
-) -> Result<Vec<Group>> {
+    given: Option<&[f64]>,
+) -> Result<(Vec<Group>, Vec<f64>)> {
     let samples = state.samples;
     let n = samples.len();
     let emitted = state.ledger.emitted.element_sum();
@@ -390,7 +501,7 @@ fn sweep(
         // Row sums: one sweep with unit radiosity everywhere, unscaled. Each sample's normalised
         // row sum is by reciprocity also the share of what it shoots that the links should
         // deliver (see `balance`).
-        let mut rows = Vec::new();
+        let mut rows = given.map_or_else(Vec::new, <[f64]>::to_vec);
         if settings.normalise {
             set(&vec![DVec3::ONE; n], &[]);
             let mut kept = Vec::with_capacity(groups.len());
@@ -520,9 +631,9 @@ fn sweep(
                 tail(state, shot);
             }
         }
-        Ok(())
-    })?;
-    Ok(groups)
+        Ok(rows)
+    })
+    .map(|rows| (groups, rows))
 }
 
 /// Reflections beyond this share per sweep are not extrapolated (the tail's factor r/(1 − r)
