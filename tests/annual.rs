@@ -334,7 +334,7 @@ fn the_office_year_matches_one_moment_solves_hour_by_hour() {
         }
         // The hours span clear and overcast skies, the sun in and out of the window.
         assert!(
-            clear >= 3 && overcast >= 3 && sun_in >= 2 && sun_in < 20,
+            clear >= 3 && overcast >= 3 && (2..20).contains(&sun_in),
             "{clear} {overcast} {sun_in}"
         );
         eprintln!(

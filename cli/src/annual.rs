@@ -110,7 +110,7 @@ pub fn plans(
                 .collect()
         };
         let s = &g.summary;
-        let maps: [(&str, Vec<f64>, &str, String, Vec<String>); 3] = [
+        let maps = [
             (
                 "da",
                 pick(&|m| m.da),
