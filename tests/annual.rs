@@ -211,6 +211,106 @@ fn a_synthetic_year_gives_the_metrics_counted_by_hand() {
     }
 }
 
+/// The synthetic year's open floor with one grid and `[annual]`.
+fn open_floor() -> Scene {
+    let mut b = Builder::default();
+    let floor = b.material(material("floor", 0.5, 0.0));
+    b.quad(
+        [
+            Vec3::new(-5.0, 0.0, -5.0),
+            Vec3::new(-5.0, 0.0, 5.0),
+            Vec3::new(5.0, 0.0, 5.0),
+            Vec3::new(5.0, 0.0, -5.0),
+        ],
+        floor,
+    );
+    let mut scene = b.scene(camera(Vec3::new(0.0, 2.0, -4.0), Vec3::ZERO, 16));
+    let grid = Grid::new(
+        "open",
+        Vec3::new(-0.5, 1.0, -0.5),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        Some(Vec3::Y),
+        Some(0.5),
+    )
+    .unwrap();
+    scene.add_grid(grid).unwrap();
+    scene.set_annual(Some(AnnualSettings {
+        weather: "synthetic.epw".into(),
+        hours: (8, 18),
+        sky_subdivision: 1,
+        site: Site::default(),
+    }));
+    scene
+}
+
+#[test]
+fn a_stopped_year_counts_the_hours_done_and_a_year_without_its_parts_is_an_error() {
+    let weather = synthetic_year(|_, h| {
+        if (9..=18).contains(&h) {
+            (0.0, 1000.0)
+        } else {
+            (0.0, 0.0)
+        }
+    });
+    let scene = open_floor();
+    let vis = Backend::default_backend().build(&scene).unwrap();
+    let options = AnnualOptions::default();
+    // Stopped among the hours: the metrics of those done, counted consistently.
+    let year = annual(&scene, &weather, vis.as_ref(), &options, &mut |p| {
+        if p.phase == meshlight::Phase::Hours && p.fraction > 0.3 {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    })
+    .unwrap();
+    assert!(year.stopped);
+    let done = year.sun_hours.len();
+    assert!(done > 0 && done < 3650, "{done}");
+    let g = &year.grids[0];
+    assert_eq!(g.summary.daylight_hours as usize, done);
+    assert!(g.summary.occupied_hours as usize >= done);
+    // Stopped while the coefficients are shot: no hours.
+    let year = annual(&scene, &weather, vis.as_ref(), &options, &mut |p| {
+        if p.phase == meshlight::Phase::Coefficients && p.fraction > 0.1 {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    })
+    .unwrap();
+    assert!(year.stopped && year.sun_hours.is_empty());
+    // Without [annual], or without grids: an error naming what is missing.
+    let mut bare = scene.clone();
+    bare.set_annual(None);
+    let e = annual(&bare, &weather, vis.as_ref(), &options, &mut |_| {
+        Control::Continue
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("has no [annual]"), "{e}");
+    // A budget too small for the coefficients is refused before they are held.
+    let tight = AnnualOptions {
+        solver: Options {
+            // About 280 samples: the solve fits, its sky rays' 5 KiB a sample do not.
+            epsilon: Some(0.5),
+            memory_budget: 7 << 18,
+            ..Options::default()
+        },
+        ..AnnualOptions::default()
+    };
+    match annual(&scene, &weather, vis.as_ref(), &tight, &mut |_| {
+        Control::Continue
+    }) {
+        Err(e @ meshlight::Error::Budget { .. }) => {
+            assert!(e.to_string().contains("a year of daylight needs"), "{e}")
+        }
+        Err(e) => panic!("{e}"),
+        Ok(_) => panic!("a year beyond its budget ran"),
+    }
+}
+
 /// The office's scene file with `[annual]` replaced by one moment's Perez sky.
 fn office_at(weather: &Weather, h: &meshlight::daylight::epw::WeatherHour) -> Scene {
     let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/office"));

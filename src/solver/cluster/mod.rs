@@ -100,29 +100,8 @@ pub(crate) fn shoot(
         return Ok(stats);
     }
 
-    // The tree, weighing each shooter by its radiosity.
-    let (weight, reference) = shooter_weights(state);
-    let rho: Vec<f32> = state
-        .reflectance
-        .iter()
-        .map(|r| r.max_element() as f32)
-        .collect();
-    let tree = Tree::build(samples, &rho, &weight, cx);
-    debug_assert_eq!(tree.validate(samples), Ok(()));
-    let roots = tree.cut(group_size(n));
+    let (tree, groups, flow) = tree_and_links(state, vis, settings, cx, &mut stats, report)?;
     let ranks = settings.ranks;
-    let linker = Linker {
-        tree: &tree,
-        samples,
-        maps: state.maps,
-        vis,
-        lift: settings.lift,
-        tolerance: settings.threshold * reference,
-        faint_links: !settings.exact_visibility,
-        seed: settings.seed,
-        halt: &std::sync::atomic::AtomicBool::new(false),
-    };
-    let (groups, flow) = link_groups(&linker, &roots, settings, &mut stats, report)?;
     // Each rank gives 3 values a sample of its groups to every sweep's exchange.
     let mut counts = vec![0usize; ranks.size().max(1)];
     for g in &groups {
@@ -161,6 +140,41 @@ pub(crate) fn shoot(
     Ok(stats)
 }
 
+/// The tree, weighing each shooter by its radiosity, and every receiver group's links; whether
+/// the host let the linking finish.
+fn tree_and_links(
+    state: &State,
+    vis: &dyn Visibility,
+    settings: &Settings,
+    cx: &Context,
+    stats: &mut ShootStats,
+    report: &mut dyn FnMut(Tick) -> Control,
+) -> Result<(Tree, Vec<Group>, ControlFlow<()>)> {
+    let samples = state.samples;
+    let (weight, reference) = shooter_weights(state);
+    let rho: Vec<f32> = state
+        .reflectance
+        .iter()
+        .map(|r| r.max_element() as f32)
+        .collect();
+    let tree = Tree::build(samples, &rho, &weight, cx);
+    debug_assert_eq!(tree.validate(samples), Ok(()));
+    let roots = tree.cut(group_size(samples.len()));
+    let linker = Linker {
+        tree: &tree,
+        samples,
+        maps: state.maps,
+        vis,
+        lift: settings.lift,
+        tolerance: settings.threshold * reference,
+        faint_links: !settings.exact_visibility,
+        seed: settings.seed,
+        halt: &std::sync::atomic::AtomicBool::new(false),
+    };
+    let (groups, flow) = link_groups(&linker, &roots, settings, stats, report)?;
+    Ok((tree, groups, flow))
+}
+
 /// One tree and its links with their row sums, kept to shoot many lightings of the same
 /// samples (`solver::basis`): sweeps only, no linking, for each.
 pub(crate) struct Linked {
@@ -183,29 +197,9 @@ pub(crate) fn link(
     cx: &Context,
     report: &mut dyn FnMut(Tick) -> Control,
 ) -> Result<Option<Linked>> {
-    let samples = state.samples;
-    let n = samples.len();
+    let n = state.samples.len();
     let mut stats = ShootStats::new();
-    let (weight, reference) = shooter_weights(state);
-    let rho: Vec<f32> = state
-        .reflectance
-        .iter()
-        .map(|r| r.max_element() as f32)
-        .collect();
-    let tree = Tree::build(samples, &rho, &weight, cx);
-    let roots = tree.cut(group_size(n));
-    let linker = Linker {
-        tree: &tree,
-        samples,
-        maps: state.maps,
-        vis,
-        lift: settings.lift,
-        tolerance: settings.threshold * reference,
-        faint_links: !settings.exact_visibility,
-        seed: settings.seed,
-        halt: &std::sync::atomic::AtomicBool::new(false),
-    };
-    let (groups, flow) = link_groups(&linker, &roots, settings, &mut stats, report)?;
+    let (tree, groups, flow) = tree_and_links(state, vis, settings, cx, &mut stats, report)?;
     if flow.is_break() {
         return Ok(None);
     }
