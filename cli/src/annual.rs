@@ -80,7 +80,8 @@ pub fn year(
          coefficients {}; weather read in {reading:.2} s, the year in {seconds:.2} s{peak}",
         year.samples,
         year.bases,
-        year.bases - 1 - meshlight::annual::SUN_POSITIONS,
+        year.bases
+            .saturating_sub(1 + meshlight::annual::SUN_POSITIONS),
         meshlight::annual::SUN_POSITIONS,
         meshlight::budget::human_bytes(year.coefficient_bytes as f64),
     ));
