@@ -87,13 +87,20 @@ pub fn before_solve(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>>
         .daylight()
         .is_some_and(|d| d.diffuse_horizontal() > 0.0 || d.ground_luminance() > 0.0);
     if scene.emitted_power().max_element() <= 0.0 && !daylight {
+        let message = if scene.annual().is_some() {
+            // A year's scene has daylight, but not for one moment.
+            "nothing lights the scene at one moment: its daylight is a year of weather \
+             ([annual]), which `meshlight annual` (or `meshlight report`) computes; for one \
+             moment give a [sky] (model = \"cie-overcast\", say), or lamps"
+        } else {
+            "nothing in the scene emits light: no material has a non-zero Ke, and there is no \
+             point light or luminaire. (Blender's OBJ exporter writes Ke 0 for a plain Emission \
+             node: set the light's material Ke in the MTL, or a [material.NAME] ke in the scene \
+             file, or add a [[point_light]].)"
+        };
         found.push(Finding {
             fatal: true,
-            message: "nothing in the scene emits light: no material has a non-zero Ke, and \
-                      there is no point light or luminaire. (Blender's OBJ exporter writes Ke 0 \
-                      for a plain Emission node: set the light's material Ke in the MTL, or a \
-                      [material.NAME] ke in the scene file, or add a [[point_light]].)"
-                .into(),
+            message: message.into(),
         });
         return Ok(found);
     }

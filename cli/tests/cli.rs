@@ -1148,6 +1148,14 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
         stderr.contains("greensboro.epw:500: 492 hourly rows"),
         "{stderr}"
     );
+    // One moment of a year's scene without a sky: told where its daylight is.
+    let out = meshlight(&["lux", "scenes/office/annual.toml", "--quiet"]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("its daylight is a year of weather ([annual])"),
+        "{}",
+        text(&out.stderr)
+    );
     let out = meshlight(&["annual", "scenes/office/scene.toml", "--quiet"]);
     assert!(!out.status.success());
     assert!(
