@@ -211,8 +211,9 @@ fn a_synthetic_year_gives_the_metrics_counted_by_hand() {
     }
 }
 
-/// The synthetic year's open floor with one grid and `[annual]`.
-fn open_floor() -> Scene {
+/// The synthetic year's open floor with one grid and `[annual]`; with `wall`, a wall beside
+/// the grid (shadows and inter-reflection, not open sky alone).
+fn open_floor(wall: bool) -> Scene {
     let mut b = Builder::default();
     let floor = b.material(material("floor", 0.5, 0.0));
     b.quad(
@@ -224,6 +225,18 @@ fn open_floor() -> Scene {
         ],
         floor,
     );
+    if wall {
+        let m = b.material(material("wall", 0.7, 0.0));
+        b.quad(
+            [
+                Vec3::new(1.0, 0.0, -2.0),
+                Vec3::new(1.0, 0.0, 2.0),
+                Vec3::new(1.0, 3.0, 2.0),
+                Vec3::new(1.0, 3.0, -2.0),
+            ],
+            m,
+        );
+    }
     let mut scene = b.scene(camera(Vec3::new(0.0, 2.0, -4.0), Vec3::ZERO, 16));
     let grid = Grid::new(
         "open",
@@ -253,7 +266,7 @@ fn a_stopped_year_counts_the_hours_done_and_a_year_without_its_parts_is_an_error
             (0.0, 0.0)
         }
     });
-    let scene = open_floor();
+    let scene = open_floor(false);
     let vis = Backend::default_backend().build(&scene).unwrap();
     let options = AnnualOptions::default();
     // Stopped among the hours: the metrics of those done, counted consistently.
@@ -309,6 +322,41 @@ fn a_stopped_year_counts_the_hours_done_and_a_year_without_its_parts_is_an_error
         Err(e) => panic!("{e}"),
         Ok(_) => panic!("a year beyond its budget ran"),
     }
+}
+
+#[test]
+fn one_and_two_threads_give_the_same_year() {
+    // Sun every tenth day at noon, so the sun lattice and the shadow rays are in it too.
+    let weather = synthetic_year(|d, h| match h {
+        13 if d % 10 == 0 => (80_000.0, 12_000.0),
+        9..=18 => (0.0, 8_000.0),
+        _ => (0.0, 0.0),
+    });
+    let scene = open_floor(true);
+    let years: Vec<Year> = [1, 2]
+        .iter()
+        .map(|&threads| {
+            let options = AnnualOptions {
+                solver: Options {
+                    threads,
+                    epsilon: Some(0.5),
+                    ..Options::default()
+                },
+                lux: LuxOptions {
+                    threads,
+                    ..LuxOptions::default()
+                },
+                hourly: true,
+            };
+            let vis = Backend::default_backend().build(&scene).unwrap();
+            annual(&scene, &weather, vis.as_ref(), &options, &mut |_| {
+                Control::Continue
+            })
+            .unwrap()
+        })
+        .collect();
+    assert_eq!(years[0].grids[0].hourly, years[1].grids[0].hourly);
+    assert_eq!(years[0].grids[0].metrics, years[1].grids[0].metrics);
 }
 
 /// The office's scene file with `[annual]` replaced by one moment's Perez sky.
