@@ -101,34 +101,8 @@ fn a_synthetic_year_gives_the_metrics_counted_by_hand() {
         (dn, sky[(d % 4) as usize])
     };
     let weather = synthetic_year(light);
-    let mut b = Builder::default();
-    let floor = b.material(material("floor", 0.0, 0.0));
-    b.quad(
-        [
-            Vec3::new(-5.0, 0.0, -5.0),
-            Vec3::new(-5.0, 0.0, 5.0),
-            Vec3::new(5.0, 0.0, 5.0),
-            Vec3::new(5.0, 0.0, -5.0),
-        ],
-        floor,
-    );
-    let mut scene = b.scene(camera(Vec3::new(0.0, 2.0, -4.0), Vec3::ZERO, 16));
-    let grid = Grid::new(
-        "open",
-        Vec3::new(-0.5, 1.0, -0.5),
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, 1.0),
-        Some(Vec3::Y),
-        Some(0.5),
-    )
-    .unwrap();
-    scene.add_grid(grid).unwrap();
-    scene.set_annual(Some(AnnualSettings {
-        weather: "synthetic.epw".into(),
-        hours: (8, 18),
-        sky_subdivision: 1,
-        site: Site::default(),
-    }));
+    // A black floor: no light comes back from it.
+    let scene = open_floor(0.0, false);
     // By hand: which hours reach 300 lx, which are useful, which have sun.
     let (mut above, mut useful, mut sun, mut exposure) = (0u32, 0u32, 0u32, 0.0f64);
     let observer = Observer {
@@ -211,11 +185,11 @@ fn a_synthetic_year_gives_the_metrics_counted_by_hand() {
     }
 }
 
-/// The synthetic year's open floor with one grid and `[annual]`; with `wall`, a wall beside
-/// the grid (shadows and inter-reflection, not open sky alone).
-fn open_floor(wall: bool) -> Scene {
+/// An open floor of reflectance `kd` with one grid 1 m over it and `[annual]`; with `wall`, a
+/// wall beside the grid (shadows and inter-reflection, not open sky alone).
+fn open_floor(kd: f32, wall: bool) -> Scene {
     let mut b = Builder::default();
-    let floor = b.material(material("floor", 0.5, 0.0));
+    let floor = b.material(material("floor", kd, 0.0));
     b.quad(
         [
             Vec3::new(-5.0, 0.0, -5.0),
@@ -266,7 +240,7 @@ fn a_stopped_year_counts_the_hours_done_and_a_year_without_its_parts_is_an_error
             (0.0, 0.0)
         }
     });
-    let scene = open_floor(false);
+    let scene = open_floor(0.5, false);
     let vis = Backend::default_backend().build(&scene).unwrap();
     let options = AnnualOptions::default();
     // Stopped among the hours: the metrics of those done, counted consistently.
@@ -332,7 +306,7 @@ fn one_and_two_threads_give_the_same_year() {
         9..=18 => (0.0, 8_000.0),
         _ => (0.0, 0.0),
     });
-    let scene = open_floor(true);
+    let scene = open_floor(0.5, true);
     let years: Vec<Year> = [1, 2]
         .iter()
         .map(|&threads| {
