@@ -8,7 +8,8 @@
 //! sculpture, a picture hanging in front of a wall) cannot stand between them; a partition on a
 //! floor node, a pedestal, a frame bar across a wall node can.
 //!
-//! Incoherent nodes are only ever split, never linked; single samples are always coherent. The
+//! Incoherent nodes are split, and linked only in pairs of so few member pairs that every pair
+//! is probed (then nothing can hide behind the occluder); single samples are always coherent. The
 //! tree splits a side's incoherent node along the plane of the triangle standing among its
 //! members (as a BSP would), so that an occluder costs a few incoherent nodes, not every node
 //! its outline crosses.

@@ -7,7 +7,9 @@
 //!   cones and the pair's angular size, say so), or when it is a planar node with itself;
 //! - a pair of leaf links when both are single samples: the flat solver's form factors and one
 //!   ray;
-//! - a pair of cluster links (A → B and B → A) when both nodes are coherent, well separated
+//! - a pair of cluster links (A → B and B → A) when both nodes are coherent (or the pair has
+//!   so few member pairs that the probes see every one, so nothing can hide behind what stands
+//!   among the members: a partial view then gives leaf links), well separated
 //!   (d > 2(r_A + r_B), and beyond the near field of either node's largest sample), and the
 //!   bound on the radiosity error either link can make at its receiver is below the tolerance:
 //!   ρ_max(R) · P_S · (c_S⁺c_R⁺/(d − r)² − c_S⁻c_R⁻/(d + r)²) / π, with P_S the power the
@@ -441,9 +443,12 @@ impl Linker<'_> {
             // No member of one faces any member of the other.
             return;
         };
+        // A pair with an incoherent node (something stands among its members) is probed pair by
+        // pair when it has few member pairs: those rays are the ones its leaf links would cast,
+        // and where every pair sees, nothing hides behind what stands among them.
+        let coherent = av.coherent && bv.coherent;
         let admissible = dist > 2.0 * reach
-            && av.coherent
-            && bv.coherent
+            && (coherent || (av.count as usize) * (bv.count as usize) <= EXHAUSTIVE)
             && dist - reach >= NEAR * av.max_area.max(bv.max_area).sqrt();
         if admissible {
             // Where some members may face away, only the bound from above holds (their pairs
