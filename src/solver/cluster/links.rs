@@ -20,8 +20,11 @@
 //!   dropped. Unless some of the pairs were left unprobed and something hovers close in front
 //!   of either node (a light fixture just under a ceiling: members in its gap and members
 //!   beside it see the room differently, and all probes may land on one kind): then refined.
-//!   Some: refined; where every pair was probed, each visible pair becomes a leaf
-//!   link. Visibility never makes a link coarser. A partly visible link is averaged only where
+//!   Some: refined; where every pair was probed, each receiving member gets one link from the
+//!   whole shooter with the share of it that member sees, if it sees every shooting member
+//!   that faces it or the shooter stands for its members evenly (coherent, no fixture hovering
+//!   over any of them), else a leaf link from each shooting member it sees. Visibility never
+//!   makes a link coarser. A partly visible link is averaged only where
 //!   everything it could carry is negligible, and never with `exact_visibility`: refining every
 //!   partial link down to samples follows each doorway's silhouette sample by sample, so its
 //!   links grow faster than the samples (N^1.2 on the gallery against N^0.6);
@@ -164,6 +167,19 @@ struct Probe {
     ray: Option<u32>,
 }
 
+/// A pair whose every member pair was probed, with what its rays said.
+struct Probed<'p> {
+    pending: &'p Pending,
+    probes: &'p [Probe],
+    blocked: &'p [bool],
+    /// Whether the links' formula may stand for the whole shooter, scaled by its probes (each
+    /// node wholly in front of the other, or far from grazing).
+    usable: bool,
+    /// Whether the formula is far from grazing (see `Linker::conditioned`).
+    conditioned: bool,
+    same_group: bool,
+}
+
 /// Links found: into the first group of the pair, and into the second.
 pub(crate) type Found = (Links, Links);
 
@@ -228,23 +244,6 @@ impl Linker<'_> {
                 found.0.leaf.push(link)
             }
         };
-        let leaf_links = |found: &mut Found, i: u32, k: u32| {
-            let (iu, ku) = (i as usize, k as usize);
-            if p.dirs & INTO_B != 0 {
-                if let Some(f) =
-                    Shooter::of(self.samples, self.maps, iu).factor_to(self.samples, ku)
-                {
-                    push_leaf(found, true, LeafLink { r: k, s: i, f });
-                }
-            }
-            if p.dirs & INTO_A != 0 {
-                if let Some(f) =
-                    Shooter::of(self.samples, self.maps, ku).factor_to(self.samples, iu)
-                {
-                    push_leaf(found, false, LeafLink { r: i, s: k, f });
-                }
-            }
-        };
         let (exhaustive, one_sided, negligible) = match p.kind {
             Kind::Leaf(ab, ba) => {
                 if seen(&probes[0]) {
@@ -295,9 +294,19 @@ impl Linker<'_> {
             // Wholly visible, but some members face away.
             self.cluster_links(p, p.dirs, [factor(0), factor(1)], found, same_group);
         } else if exhaustive {
-            // Every member pair is known: the visible ones, sample to sample.
-            for q in probes.iter().filter(|q| seen(q)) {
-                leaf_links(found, q.i, q.k);
+            // Every member pair is known: see `member_links`.
+            let probed = Probed {
+                pending: p,
+                probes,
+                blocked,
+                usable: one_sided || conditioned,
+                conditioned,
+                same_group,
+            };
+            for dir in [INTO_B, INTO_A] {
+                if p.dirs & dir != 0 {
+                    self.member_links(&probed, dir, found);
+                }
             }
         } else if negligible && rays > 0 {
             // Faint and partly visible: a receiver takes the share of the shooter its probes
@@ -342,6 +351,86 @@ impl Linker<'_> {
         } else {
             let n = &self.tree.nodes[node.index()];
             n.sheltered && n.side != MULTI && n.count as usize <= HOVERED_MEMBERS
+        }
+    }
+
+    /// Whether a shooter node stands for its members evenly enough for a receiver to take the
+    /// share of it that it sees: coherent (no occluder among its members, whose unshot light
+    /// may differ across it) and holding no sample something hovers close in front of (those
+    /// in a fixture's gap get less light than their neighbours). A single sample: its leaf
+    /// links are as many.
+    fn even(&self, node: Ref) -> bool {
+        !node.is_leaf() && {
+            let n = &self.tree.nodes[node.index()];
+            n.coherent && !n.holds_hovered
+        }
+    }
+
+    /// The links in direction `dir` of a pair whose every member pair was probed and some
+    /// seen. Into each receiving member: from the whole shooter, where it stands for its members
+    /// evenly (`even`) or the member sees every one that faces it, one link with the share it
+    /// sees (its visible exact form factors over the formula's, or over all its exact ones
+    /// where the formula is not well conditioned); else each member it sees, sample to sample.
+    /// A single shooter, or a formula that cannot be scaled (members facing away and near
+    /// grazing): sample to sample.
+    fn member_links(&self, probed: &Probed, dir: u8, found: &mut Found) {
+        let p = probed.pending;
+        let into_b = dir == INTO_B;
+        let (shooter, d) = if into_b { (p.a, 0) } else { (p.b, 1) };
+        let seen = |q: &Probe| q.ray.is_some_and(|ray| !probed.blocked[ray as usize]);
+        let receiver = |q: &Probe| if into_b { q.k } else { q.i };
+        let even = !shooter.is_leaf() && self.even(shooter);
+        let mut members: Vec<u32> = probed.probes.iter().map(receiver).collect();
+        members.sort_unstable();
+        members.dedup();
+        for m in members {
+            let run = || probed.probes.iter().filter(move |q| receiver(q) == m);
+            // Whether every member of the shooter faces this one (each probe has a ray).
+            let facing = run().all(|q| q.ray.is_some());
+            let (mut visible, mut whole, mut all) = (0.0f64, 0.0f64, true);
+            for q in run() {
+                if seen(q) {
+                    visible += q.exact[d];
+                } else if q.ray.is_some() {
+                    all = false;
+                }
+                whole += if probed.conditioned && !facing {
+                    q.formula[d]
+                } else {
+                    q.exact[d]
+                };
+            }
+            if visible <= 0.0 {
+                continue;
+            }
+            // Where every member of the shooter faces this one, the formula holds as for a
+            // one-sided pair, and the share is of the exact form factors.
+            let usable = !shooter.is_leaf() && (probed.usable || facing);
+            if usable && (even || all) && whole > 0.0 {
+                let link = ClusterLink {
+                    r: Ref::sample(m),
+                    s: shooter,
+                    factor: (visible / whole) as f32,
+                };
+                if into_b && !probed.same_group {
+                    found.1.cluster.push(link);
+                } else {
+                    found.0.cluster.push(link);
+                }
+            } else {
+                for q in run().filter(|q| seen(q)) {
+                    let (s, r) = if into_b { (q.i, q.k) } else { (q.k, q.i) };
+                    let from = Shooter::of(self.samples, self.maps, s as usize);
+                    if let Some(f) = from.factor_to(self.samples, r as usize) {
+                        let link = LeafLink { r, s, f };
+                        if into_b && !probed.same_group {
+                            found.1.leaf.push(link);
+                        } else {
+                            found.0.leaf.push(link);
+                        }
+                    }
+                }
+            }
         }
     }
 
