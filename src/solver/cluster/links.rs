@@ -23,8 +23,8 @@
 //!   Some: refined; where every pair was probed, each receiving member gets one link from the
 //!   whole shooter with the share of it that member sees, if it sees every shooting member
 //!   that faces it or the shooter stands for its members evenly (coherent, no fixture hovering
-//!   over any of them), else a leaf link from each shooting member it sees. Visibility never
-//!   makes a link coarser. A partly visible link is averaged only where
+//!   over any of them), else a link from each largest part of the shooter all of whose members
+//!   it sees and faces. Visibility never makes a link coarser. A partly visible link is averaged only where
 //!   everything it could carry is negligible, and never with `exact_visibility`: refining every
 //!   partial link down to samples follows each doorway's silhouette sample by sample, so its
 //!   links grow faster than the samples (N^1.2 on the gallery against N^0.6);
@@ -370,9 +370,9 @@ impl Linker<'_> {
     /// seen. Into each receiving member: from the whole shooter, where it stands for its members
     /// evenly (`even`) or the member sees every one that faces it, one link with the share it
     /// sees (its visible exact form factors over the formula's, or over all its exact ones
-    /// where the formula is not well conditioned); else each member it sees, sample to sample.
-    /// A single shooter, or a formula that cannot be scaled (members facing away and near
-    /// grazing): sample to sample.
+    /// where the formula is not well conditioned); else, and where the formula cannot be
+    /// scaled (members facing away and near grazing), from the parts of the shooter it wholly
+    /// sees (`cover`).
     fn member_links(&self, probed: &Probed, dir: u8, found: &mut Found) {
         let p = probed.pending;
         let into_b = dir == INTO_B;
@@ -418,18 +418,47 @@ impl Linker<'_> {
                     found.0.cluster.push(link);
                 }
             } else {
-                for q in run().filter(|q| seen(q)) {
-                    let (s, r) = if into_b { (q.i, q.k) } else { (q.k, q.i) };
-                    let from = Shooter::of(self.samples, self.maps, s as usize);
-                    if let Some(f) = from.factor_to(self.samples, r as usize) {
-                        let link = LeafLink { r, s, f };
-                        if into_b && !probed.same_group {
-                            found.1.leaf.push(link);
-                        } else {
-                            found.0.leaf.push(link);
-                        }
-                    }
+                let clear: Vec<u32> = run()
+                    .filter(|q| seen(q))
+                    .map(|q| if into_b { q.i } else { q.k })
+                    .collect();
+                let into = if into_b && !probed.same_group {
+                    &mut found.1
+                } else {
+                    &mut found.0
+                };
+                self.cover(shooter, &clear, m, into);
+            }
+        }
+    }
+
+    /// Links into sample `m` from the largest parts of `node` whose every member is in
+    /// `clear` (seen from m and facing it): one cluster link each, carrying the formula as it
+    /// is, as for a pair wholly in front of each other and seen; a leaf link from a member
+    /// alone.
+    fn cover(&self, node: Ref, clear: &[u32], m: u32, into: &mut Links) {
+        if node.is_leaf() {
+            let s = node.index() as u32;
+            if clear.contains(&s) {
+                let from = Shooter::of(self.samples, self.maps, s as usize);
+                if let Some(f) = from.factor_to(self.samples, m as usize) {
+                    into.leaf.push(LeafLink { r: m, s, f });
                 }
+            }
+            return;
+        }
+        let n = &self.tree.nodes[node.index()];
+        let members = &self.tree.order[n.first as usize..(n.first + n.count) as usize];
+        let inside = members.iter().filter(|k| clear.contains(k)).count();
+        if inside == members.len() {
+            into.cluster.push(ClusterLink {
+                r: Ref::sample(m),
+                s: node,
+                factor: 1.0,
+            });
+        } else if inside > 0 {
+            for c in n.children {
+                self.cover(c, clear, m, into);
             }
         }
     }
