@@ -170,7 +170,8 @@ fn tree_and_links(
         seed: settings.seed,
         halt: &std::sync::atomic::AtomicBool::new(false),
     };
-    let (groups, flow) = link_groups(&linker, &roots, settings, stats, report)?;
+    let room = link_room(settings.memory_bytes, tree.nodes.len());
+    let (groups, flow) = link_groups(&linker, &roots, settings, room, stats, report)?;
     Ok((tree, groups, flow))
 }
 
@@ -285,6 +286,16 @@ fn shooter_weights(state: &State) -> (Vec<f64>, f64) {
     (weight, reference)
 }
 
+/// What the links may hold of `memory_bytes` (what the samples leave of the budget): less the
+/// tree's nodes and their shooters, and a quarter of the rest kept for what is not counted
+/// (the jobs in flight, whose lists grow by doubling, the scene and its visibility structure,
+/// the allocator's slack). Without that quarter, the atrium at `--epsilon 0.3` under a 250 MiB
+/// budget stopped with a peak of 292 MiB; with it, 222 MiB (`/usr/bin/time -f %M`).
+fn link_room(memory_bytes: usize, nodes: usize) -> usize {
+    let tree = nodes * (std::mem::size_of::<tree::Node>() + std::mem::size_of::<Shooter>());
+    memory_bytes.saturating_sub(tree) / 4 * 3
+}
+
 /// Every receiver group's links: every pair of groups (each group with itself too) is a job of
 /// the pipeline, whose links go to its two groups; then one list per group, its parts in job
 /// order. The links count against what the samples leave of the memory budget as they come
@@ -303,6 +314,7 @@ fn link_groups(
     linker: &Linker,
     roots: &[Ref],
     settings: &Settings,
+    room: usize,
     stats: &mut ShootStats,
     report: &mut dyn FnMut(Tick) -> Control,
 ) -> Result<(Vec<Group>, ControlFlow<()>)> {
@@ -340,15 +352,19 @@ fn link_groups(
             let (x, y) = pairs[job];
             stats.queries += first.queries + second.queries;
             held += first.bytes() + second.bytes();
-            if held > settings.memory_bytes {
+            if held > room {
+                // The pairs' links are uneven (neighbours cost the most), so this is a guide.
+                let rate = held as f64 / (i + 1) as f64;
                 return Err(crate::budget::exceeded(
                     settings.budget,
                     format!(
-                        "the cluster links outgrew what the samples leave of the budget ({} after \
-                         {} of {} groups' pairs): raise the budget or the cluster threshold",
-                        crate::budget::human_bytes(settings.memory_bytes as f64),
+                        "the cluster links outgrew what the samples and the tree leave of the \
+                         budget ({} after {} of {} groups' pairs; at that rate all of them \
+                         would need about {}): raise the budget or choose a larger ε",
+                        crate::budget::human_bytes(room as f64),
                         i + 1,
-                        total
+                        total,
+                        crate::budget::human_bytes(rate * total as f64),
                     ),
                 ));
             }
