@@ -295,14 +295,42 @@ fn bad_texture_coordinates_are_errors_at_their_line() {
     assert!(e.starts_with("w.obj:3: texture coordinates need"), "{e}");
     let e = err("mtllib w.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/-1 2/1 3/1\n");
     assert!(e.starts_with("w.obj:5: relative texture index -1"), "{e}");
-    let e = load(QUAD, "newmtl paper\nmap_Kd -zz 1 tex.png\n", &[])
-        .err()
-        .unwrap();
-    assert!(
-        e.to_string()
-            .starts_with("w.mtl:2: material 'paper': map_Kd option '-zz'"),
-        "{e}"
-    );
+}
+
+#[test]
+fn map_kd_options_this_reader_does_not_know_are_warnings_with_their_value() {
+    // Real files: `-colorspace sRGB` (written by exporters), MTL's own `-type sphere`.
+    for (options, option) in [
+        ("-colorspace sRGB", "-colorspace"),
+        ("-type sphere", "-type"),
+        ("-zz", "-zz"),
+    ] {
+        let mtl = format!("newmtl paper\nmap_Kd {options} -s 0.5 tex.png\n");
+        let scene = load(QUAD, &mtl, &[("tex.png", two_halves())]).unwrap_or_else(|e| {
+            panic!("{options}: {e}");
+        });
+        let paper = &scene.materials()[0];
+        assert_eq!(paper.texture.as_ref().map(|t| t.size()), Some((8, 1)));
+        let said: Vec<&String> = scene
+            .warnings()
+            .iter()
+            .filter(|w| w.contains(option))
+            .collect();
+        assert_eq!(said.len(), 1, "{options}: {:?}", scene.warnings());
+        assert!(
+            said[0].starts_with("w.mtl:2: material 'paper'"),
+            "{}",
+            said[0]
+        );
+        // The option's value was not taken for the file name, and -s after it was read: the
+        // corner (1, 0, 0), vt (1, 0), lands at u 0.5.
+        let u = scene
+            .texcoords()
+            .iter()
+            .flat_map(|t| t.unwrap())
+            .fold(0.0f32, |m, uv| m.max(uv.x));
+        assert_eq!(u, 0.5, "{options}");
+    }
 }
 
 #[test]

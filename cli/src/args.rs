@@ -17,7 +17,7 @@ pub struct Args {
     #[arg(long, global = true)]
     pub strict: bool,
     /// What a reflectance channel of exactly 1 is lowered to (default: the scene file's
-    /// [solver] max_reflectance, else 0.9).
+    /// `[solver]` max_reflectance, else 0.9).
     #[arg(long, global = true)]
     pub max_reflectance: Option<f32>,
     /// The glTF camera to render from, by name (default: the scene file's [camera], else the
@@ -153,6 +153,13 @@ pub struct RenderArgs {
     /// Output image (.exr); the PNG gets the same name with .png.
     #[arg(short, long, default_value = "out.exr")]
     pub output: PathBuf,
+    /// Image width in pixels, instead of the scene's (a .glb carries none); with only one of
+    /// --width and --height, the other keeps the camera's aspect ratio.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub width: Option<u32>,
+    /// Image height in pixels, instead of the scene's.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub height: Option<u32>,
     /// Rays per side on pixels that straddle an edge (1 = one ray per pixel) [default: the
     /// preset's: preview 2, default 4, final 8].
     #[arg(long)]

@@ -267,7 +267,11 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
     if r.method != Method::Meshless && r.false_color.is_some() {
         anyhow::bail!("--false-color works with --method meshless only");
     }
-    let (scene, options) = solve_setup(&r.solve, loading)?;
+    let (mut scene, options) = solve_setup(&r.solve, loading)?;
+    if r.width.is_some() || r.height.is_some() {
+        let camera = resized(*scene.camera(), r.width, r.height);
+        scene.set_camera(camera)?;
+    }
     if r.method != Method::Meshless && ranks::ranks().size() > 1 {
         anyhow::bail!("--method {:?} runs on one rank only", r.method);
     }
@@ -477,6 +481,25 @@ fn diagnose(scene: &Scene, vis: &dyn meshlight::Visibility) -> anyhow::Result<()
         eprintln!("meshlight: warning: {}", finding.message);
     }
     Ok(())
+}
+
+/// The camera at `width` × `height` pixels; a side not given keeps the aspect ratio (at least
+/// one pixel). The field of view is vertical, so the picture's height spans the same angle.
+fn resized(
+    mut camera: meshlight::scene::Camera,
+    width: Option<u32>,
+    height: Option<u32>,
+) -> meshlight::scene::Camera {
+    let aspect = f64::from(camera.width) / f64::from(camera.height);
+    let (w, h) = match (width, height) {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, (f64::from(w) / aspect).round().max(1.0) as u32),
+        (None, Some(h)) => ((f64::from(h) * aspect).round().max(1.0) as u32, h),
+        (None, None) => (camera.width, camera.height),
+    };
+    camera.width = w;
+    camera.height = h;
+    camera
 }
 
 /// Loads a scene and prints its warnings to stderr.

@@ -1164,3 +1164,36 @@ fn annual_writes_each_points_year_and_the_grids_metrics() {
         text(&out.stderr)
     );
 }
+
+#[test]
+fn render_takes_the_image_size_from_the_command_line_keeping_the_aspect_ratio() {
+    // blender-stripes' camera is 256 × 192 (4:3).
+    let dir = tempfile::tempdir().unwrap();
+    let scene = root("scenes/blender-stripes/scene.toml");
+    for (flags, size) in [
+        (&["--width", "64"][..], (64, 48)),
+        (&["--height", "30"][..], (40, 30)),
+        (&["--width", "50", "--height", "20"][..], (50, 20)),
+    ] {
+        let out = dir.path().join("x.exr");
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--preset",
+            "preview",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(flags);
+        succeed(&args);
+        let png = image::open(out.with_extension("png")).unwrap();
+        assert_eq!((png.width(), png.height()), size, "{flags:?}");
+    }
+    let run = meshlight(&["render", scene.to_str().unwrap(), "--width", "0"]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("--width"),
+        "{}",
+        text(&run.stderr)
+    );
+}

@@ -67,8 +67,10 @@ impl UvTransform {
 }
 
 /// Options `map_Kd` may carry before the file name, with how many values each takes; only
-/// `-s` and `-o` change what meshlight shows, the others are ignored with a warning.
-const MAP_OPTIONS: [(&str, usize); 11] = [
+/// `-s` and `-o` change what meshlight shows, the others are ignored with a warning. Any other
+/// option (exporters write `-colorspace sRGB`) is ignored with a warning too, with the one
+/// value after it where a file name still follows.
+const MAP_OPTIONS: [(&str, usize); 12] = [
     ("-blendu", 1),
     ("-blendv", 1),
     ("-bm", 1),
@@ -78,6 +80,7 @@ const MAP_OPTIONS: [(&str, usize); 11] = [
     ("-imfchan", 1),
     ("-mm", 2),
     ("-texres", 1),
+    ("-type", 1),
     ("-o", 3),
     ("-s", 3),
 ];
@@ -471,12 +474,19 @@ fn map_kd(
     };
     let mut i = 0;
     while let Some(&option) = words.get(i).filter(|w| w.starts_with('-')) {
-        let Some(&(_, most)) = MAP_OPTIONS.iter().find(|(o, _)| *o == option) else {
-            return Err(format!(
-                "material '{material}': map_Kd option '{option}' is not one MTL defines"
-            ));
-        };
         i += 1;
+        let Some(&(_, most)) = MAP_OPTIONS.iter().find(|(o, _)| *o == option) else {
+            // Its value, if a word that is not an option follows and the file name after it.
+            if words.len() > i + 1 && !words[i].starts_with('-') {
+                i += 1;
+            }
+            warnings.push(format!(
+                "{}:{line}: material '{material}': map_Kd option {option} is not one this \
+                 reader knows: ignored",
+                path.display()
+            ));
+            continue;
+        };
         // -o, -s and -t take one to three numbers; the others a fixed count.
         let mut values = Vec::new();
         while values.len() < most {
