@@ -203,6 +203,15 @@ fn load(obj: &str, mtl: &str, extra: &[(&str, Vec<u8>)]) -> meshlight::Result<Sc
 }
 
 /// An 8 × 1 PNG: four black texels then four white ones.
+/// The scene's warnings that name `what`.
+fn warnings_naming<'s>(scene: &'s Scene, what: &str) -> Vec<&'s String> {
+    scene
+        .warnings()
+        .iter()
+        .filter(|w| w.contains(what))
+        .collect()
+}
+
 fn two_halves() -> Vec<u8> {
     let mut png = Vec::new();
     let texels = (0..8)
@@ -258,11 +267,7 @@ fn obj_texture_coordinates_and_map_kd_options_are_read() {
 fn a_missing_texture_is_one_warning_and_the_material_keeps_kd() {
     let mtl = "newmtl paper\nmap_Kd nowhere.png\n";
     let scene = load(QUAD, mtl, &[]).unwrap();
-    let said: Vec<&String> = scene
-        .warnings()
-        .iter()
-        .filter(|w| w.contains("nowhere.png"))
-        .collect();
+    let said = warnings_naming(&scene, "nowhere.png");
     assert_eq!(said.len(), 1, "{:?}", scene.warnings());
     assert!(
         said[0].starts_with("w.mtl:2: material 'paper'"),
@@ -311,11 +316,7 @@ fn map_kd_options_this_reader_does_not_know_are_warnings_with_their_value() {
         });
         let paper = &scene.materials()[0];
         assert_eq!(paper.texture.as_ref().map(|t| t.size()), Some((8, 1)));
-        let said: Vec<&String> = scene
-            .warnings()
-            .iter()
-            .filter(|w| w.contains(option))
-            .collect();
+        let said = warnings_naming(&scene, option);
         assert_eq!(said.len(), 1, "{options}: {:?}", scene.warnings());
         assert!(
             said[0].starts_with("w.mtl:2: material 'paper'"),

@@ -9,7 +9,7 @@
 //!   ray;
 //! - a pair of cluster links (A → B and B → A) when both nodes are coherent (or the pair has
 //!   so few member pairs that the probes see every one, so nothing can hide behind what stands
-//!   among the members: a partial view then gives leaf links), well separated
+//!   among the members: a partial view then links member by member, below), well separated
 //!   (d > 2(r_A + r_B), and beyond the near field of either node's largest sample), and the
 //!   bound on the radiosity error either link can make at its receiver is below the tolerance:
 //!   ρ_max(R) · P_S · (c_S⁺c_R⁺/(d − r)² − c_S⁻c_R⁻/(d + r)²) / π, with P_S the power the
@@ -24,8 +24,9 @@
 //!   whole shooter with the share of it that member sees, if it sees every shooting member
 //!   that faces it or the shooter stands for its members evenly (coherent, no fixture hovering
 //!   over any of them), else a link from each largest part of the shooter all of whose members
-//!   it sees and faces. Visibility never makes a link coarser. A partly visible link is averaged only where
-//!   everything it could carry is negligible, and never with `exact_visibility`: refining every
+//!   it sees and faces. Visibility never makes a link coarser. A partly visible link is
+//!   averaged only where everything it could carry is negligible, and never with
+//!   `exact_visibility`: refining every
 //!   partial link down to samples follows each doorway's silhouette sample by sample, so its
 //!   links grow faster than the samples (N^1.2 on the gallery against N^0.6);
 //! - otherwise refined: the larger node (the one holding the other, if so) is split.
@@ -172,9 +173,8 @@ struct Probed<'p> {
     pending: &'p Pending,
     probes: &'p [Probe],
     blocked: &'p [bool],
-    /// Whether the links' formula may stand for the whole shooter, scaled by its probes (each
-    /// node wholly in front of the other, or far from grazing).
-    usable: bool,
+    /// Whether each node lies wholly in front of the other.
+    one_sided: bool,
     /// Whether the formula is far from grazing (see `Linker::conditioned`).
     conditioned: bool,
     same_group: bool,
@@ -299,7 +299,7 @@ impl Linker<'_> {
                 pending: p,
                 probes,
                 blocked,
-                usable: one_sided || conditioned,
+                one_sided,
                 conditioned,
                 same_group,
             };
@@ -379,7 +379,12 @@ impl Linker<'_> {
         let (shooter, d) = if into_b { (p.a, 0) } else { (p.b, 1) };
         let seen = |q: &Probe| q.ray.is_some_and(|ray| !probed.blocked[ray as usize]);
         let receiver = |q: &Probe| if into_b { q.k } else { q.i };
-        let even = !shooter.is_leaf() && self.even(shooter);
+        let into = if into_b && !probed.same_group {
+            &mut found.1
+        } else {
+            &mut found.0
+        };
+        let even = self.even(shooter);
         let mut members: Vec<u32> = probed.probes.iter().map(receiver).collect();
         members.sort_unstable();
         members.dedup();
@@ -405,28 +410,18 @@ impl Linker<'_> {
             }
             // Where every member of the shooter faces this one, the formula holds as for a
             // one-sided pair, and the share is of the exact form factors.
-            let usable = !shooter.is_leaf() && (probed.usable || facing);
+            let usable = !shooter.is_leaf() && (probed.one_sided || probed.conditioned || facing);
             if usable && (even || all) && whole > 0.0 {
-                let link = ClusterLink {
+                into.cluster.push(ClusterLink {
                     r: Ref::sample(m),
                     s: shooter,
                     factor: (visible / whole) as f32,
-                };
-                if into_b && !probed.same_group {
-                    found.1.cluster.push(link);
-                } else {
-                    found.0.cluster.push(link);
-                }
+                });
             } else {
                 let clear: Vec<u32> = run()
                     .filter(|q| seen(q))
                     .map(|q| if into_b { q.i } else { q.k })
                     .collect();
-                let into = if into_b && !probed.same_group {
-                    &mut found.1
-                } else {
-                    &mut found.0
-                };
                 self.cover(shooter, &clear, m, into);
             }
         }

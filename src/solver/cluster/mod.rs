@@ -297,8 +297,9 @@ fn link_room(memory_bytes: usize, nodes: usize) -> usize {
 }
 
 /// Every receiver group's links: every pair of groups (each group with itself too) is a job of
-/// the pipeline, whose links go to its two groups; then each group's parts, in job order. The links count against what the samples leave of the memory budget as they come
-/// in. Whether the host let the linking finish.
+/// the pipeline, whose links go to its two groups; then each group's parts, in job order. The
+/// links count against what the samples and the tree leave of the memory budget (`link_room`)
+/// as they come in. Whether the host let the linking finish.
 ///
 /// A group's parts are kept as they came, not joined into one list: the sweeps read them in
 /// job order all the same, and joining held every link twice for a moment, which the
