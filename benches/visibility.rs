@@ -5,8 +5,11 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use meshlight::visibility::workload::{camera_rays, facing_segments};
 use meshlight::{Backend, Scene};
+
+#[path = "../cli/src/workload.rs"]
+mod workload;
+use workload::{camera_rays, facing_segments};
 
 const SEGMENTS: usize = 100_000;
 const RAYS: usize = 20_000;

@@ -53,7 +53,7 @@ impl Breakdown {
 }
 
 /// Bytes in binary units, for messages: "3.2 GiB".
-pub fn human_bytes(bytes: f64) -> String {
+pub(crate) fn human_bytes(bytes: f64) -> String {
     const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
     let mut value = bytes;
     let mut unit = 0;
@@ -71,7 +71,7 @@ pub fn human_bytes(bytes: f64) -> String {
 /// A count for messages: digits grouped below a billion ("1,234,567"), three significant
 /// figures in scientific notation above ("5.60e55"), so a mistaken input never prints a
 /// number sixty digits long.
-pub fn human_count(count: f64) -> String {
+pub(crate) fn human_count(count: f64) -> String {
     if !count.is_finite() || count.abs() >= 1e9 {
         return format!("{count:.2e}");
     }
@@ -91,7 +91,7 @@ pub fn human_count(count: f64) -> String {
 
 /// A number for messages: as Rust prints it between 0.001 and a million, in scientific notation
 /// outside ("1e-12", "2.4e14").
-pub fn human_number(x: f32) -> String {
+pub(crate) fn human_number(x: f32) -> String {
     if x == 0.0 || (1e-3..1e6).contains(&x.abs()) || !x.is_finite() {
         format!("{x}")
     } else {

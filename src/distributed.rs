@@ -107,9 +107,9 @@ impl Ranks for Single {
     }
 }
 
-/// Checks one all-gather's lengths (`rank` giving `mine` values into `out`): an implementation
-/// calls it first.
-pub fn check(mine: usize, counts: &[usize], out: usize, rank: usize) -> Result<()> {
+/// Checks one all-gather's lengths (`rank` giving `mine` values into `out`): done before every
+/// call to a host's transport, so an implementation need not.
+pub(crate) fn check(mine: usize, counts: &[usize], out: usize, rank: usize) -> Result<()> {
     let total: usize = counts.iter().sum();
     if counts.get(rank) != Some(&mine) || total != out {
         return Err(Error::Worker {

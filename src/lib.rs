@@ -4,7 +4,10 @@
 //! rendering by interpolation), with a hierarchy of sample clusters beyond the paper
 //! (`docs/method.md`).
 //!
-//! The data flows scene → visibility → samples → areas → solver → render:
+//! The data flows scene → visibility → solver → field → render: [`solve`] places the samples
+//! (Poisson disk), gives them representative areas, lights them (direct, specular, daylight)
+//! and shoots their light between them, and leaves a [`Field`] (the samples and their light);
+//! [`render()`], [`lux::illuminance`] and [`ply`] read that field and nothing else of the solve:
 //!
 //! ```
 //! use meshlight::{Backend, Control, Options, RenderOptions, Scene};
@@ -52,6 +55,7 @@ pub mod daylight;
 pub mod diagnose;
 pub mod distributed;
 pub mod error;
+pub mod field;
 pub mod ies;
 mod light;
 pub mod lux;
@@ -69,6 +73,7 @@ mod specular;
 pub mod visibility;
 
 pub use error::{Error, Result};
+pub use field::Field;
 pub use light::MAX_LIGHT_SAMPLES;
 pub use progress::{Control, Phase, Progress};
 pub use render::{render, Direct, Image, Quantity, RenderOptions};

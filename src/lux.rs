@@ -9,10 +9,11 @@
 use glam::{DVec3, Vec3};
 
 use crate::error::Result;
+use crate::field::interpolate::{Interpolator, Site};
+use crate::field::Field;
 use crate::light::{Arrival, DirectLight};
 use crate::parallel::for_chunks_reporting;
 use crate::progress::{Callback, Phase, Progress, Reporter};
-use crate::render::interpolate::{Interpolator, Site};
 use crate::scene::{Grid, Scene};
 use crate::solver::Solution;
 use crate::specular::gather::Chains;
@@ -107,7 +108,7 @@ pub fn illuminance(
         };
         // Direct light: the solver's estimator at the points, facing the grid's normal.
         let light =
-            DirectLight::with_specular(scene, options.light_samples, solution.specular_depth);
+            DirectLight::with_specular(scene, options.light_samples, solution.field.specular_depth);
         let at: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, n)).collect();
         let ids: Vec<u32> = (0..points.len() as u32).collect();
         let (mut direct, _) = if reporter.report(base) {
@@ -141,12 +142,12 @@ pub fn illuminance(
             }
         }
         // Inter-reflected light from every sample.
-        let s = &solution.samples;
+        let s = &solution.field.samples;
         let reflected: Vec<DVec3> = (0..s.len())
-            .map(|k| solution.radiosity[k] - crate::solver::emission_of(scene, s, k))
+            .map(|k| solution.field.radiosity[k] - crate::solver::emission_of(scene, s, k))
             .collect();
         let lift = crate::visibility::lift(scene);
-        let specular = specular_gather(scene, solution, vis, options)?;
+        let specular = specular_gather(scene, &solution.field, vis, options)?;
         let mut gathered: Vec<Option<DVec3>> = vec![None; points.len()];
         let gather = |first: usize, out: &mut [Option<DVec3>]| {
             let by_way_of_specular = match &specular {
@@ -251,9 +252,9 @@ pub(crate) fn gather_rows(
 ) -> Result<Vec<Vec<(u32, Vec3)>>> {
     let points = grid.points();
     let n = grid.normal;
-    let s = &solution.samples;
+    let s = &solution.field.samples;
     let lift = crate::visibility::lift(scene);
-    let specular = specular_gather(scene, solution, vis, options)?;
+    let specular = specular_gather(scene, &solution.field, vis, options)?;
     let mut rows: Vec<Vec<(u32, Vec3)>> = vec![Vec::new(); points.len()];
     let gather = |first: usize, out: &mut [Vec<(u32, Vec3)>]| {
         let through = match &specular {
@@ -294,23 +295,23 @@ struct SpecularGather<'a> {
     seed: u64,
 }
 
-/// The gather through specular surfaces, where the solution has them.
+/// The gather through specular surfaces, where the field has them.
 fn specular_gather<'a>(
     scene: &'a Scene,
-    solution: &'a Solution,
+    field: &'a Field,
     vis: &'a dyn Visibility,
     options: &LuxOptions,
 ) -> Result<Option<SpecularGather<'a>>> {
-    if solution.specular.is_none() {
+    if !field.specular {
         return Ok(None);
     }
     Ok(Some(SpecularGather {
         spec: Specular::of(scene),
         lights: Lights::new(scene),
-        interpolator: Interpolator::new(scene, solution, vis),
+        interpolator: Interpolator::new(scene, field, vis),
         scene,
         vis,
-        depth: solution.specular_depth,
+        depth: field.specular_depth,
         rays: options.specular_rays,
         seed: options.seed,
     }))
@@ -399,7 +400,7 @@ impl SpecularGather<'_> {
             .ends
             .iter()
             .zip(covered)
-            .map(|(e, covered)| e.site(covered))
+            .map(|(e, covered)| Site::at(e.point, e.side, e.normal, covered))
             .collect();
         let mut weights = Vec::new();
         self.interpolator.weights(&sites, &mut weights)?;

@@ -15,7 +15,8 @@ pub fn write_samples(solution: &Solution, path: &Path, exposure: f32) -> Result<
     };
     let file = std::fs::File::create(path).map_err(fail)?;
     let mut out = std::io::BufWriter::new(file);
-    let s = &solution.samples;
+    let field = solution.field();
+    let s = &field.samples;
     write!(
         out,
         "ply\nformat ascii 1.0\ncomment meshlight samples: colour = radiance B/pi x {exposure}\n\
@@ -28,7 +29,7 @@ pub fn write_samples(solution: &Solution, path: &Path, exposure: f32) -> Result<
     .map_err(fail)?;
     for k in 0..s.len() {
         let (p, n) = (s.position[k], s.normal[k]);
-        let radiance = (solution.radiosity[k] / std::f64::consts::PI).as_vec3() * exposure;
+        let radiance = (field.radiosity[k] / std::f64::consts::PI).as_vec3() * exposure;
         let c = radiance
             .to_array()
             .map(|v| (crate::render::image::srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8);

@@ -5,10 +5,13 @@
 
 use std::path::PathBuf;
 
-use meshlight::visibility::workload::{camera_rays, facing_segments};
 use meshlight::visibility::{intersect_all, occluded_all, Visibility};
 use meshlight::visibility::{BvhPreset, BvhScene, EmbreeOptions, EmbreeScene, Hit, Ray, Segment};
 use meshlight::Scene;
+
+#[path = "../cli/src/workload.rs"]
+mod workload;
+use workload::{camera_rays, facing_segments};
 
 const SEGMENTS: usize = 1_000_000;
 const RAYS: usize = 100_000;

@@ -8,7 +8,7 @@ mod common;
 
 use std::sync::{Arc, Barrier, Mutex};
 
-use meshlight::distributed::{check, Ranks};
+use meshlight::distributed::Ranks;
 use meshlight::{Control, Image, Options, RenderOptions, Scene, Solution};
 
 /// What the simulated ranks share: a slot per rank, and a barrier.
@@ -34,7 +34,6 @@ impl Ranks for Threaded {
     }
 
     fn all_gather(&self, mine: &[f64], counts: &[usize], out: &mut [f64]) -> meshlight::Result<()> {
-        check(mine.len(), counts, out.len(), self.rank)?;
         self.shared.slots.lock().unwrap()[self.rank] = mine.to_vec();
         self.shared.barrier.wait();
         {

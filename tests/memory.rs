@@ -55,7 +55,7 @@ fn a_budget_too_small_is_refused_before_allocating_and_names_the_predicted_size(
     assert!(
         problem.contains(&format!(
             "about {} samples",
-            meshlight::budget::human_count(samples)
+            grouped(samples.round() as u64)
         )),
         "{problem}"
     );
@@ -130,4 +130,17 @@ fn where_the_budget_binds_the_flat_solver_keeps_fewer_form_factors_and_gives_the
     // Below what the samples are predicted to take, the flat solver refuses too.
     let e = solve(&room, &flat(16 << 20)).unwrap_err();
     assert!(matches!(e, Error::Budget { .. }), "{e}");
+}
+
+/// Digits in groups of three, as messages print counts: 12,345.
+fn grouped(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }

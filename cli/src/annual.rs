@@ -73,7 +73,7 @@ pub fn year(
         lines.push(summary(g));
     }
     let peak = crate::memory::peak_bytes()
-        .map(|b| format!(", peak memory {}", meshlight::budget::human_bytes(b as f64)))
+        .map(|b| format!(", peak memory {}", crate::units::bytes(b as f64)))
         .unwrap_or_default();
     lines.push(format!(
         "year: {} samples, {} coefficients a point ({} sky patches + ground, {} sun positions), \
@@ -83,7 +83,7 @@ pub fn year(
         year.bases
             .saturating_sub(1 + meshlight::annual::SUN_POSITIONS),
         meshlight::annual::SUN_POSITIONS,
-        meshlight::budget::human_bytes(year.coefficient_bytes as f64),
+        crate::units::bytes(year.coefficient_bytes as f64),
     ));
     for line in &lines {
         println!("{line}");

@@ -5,7 +5,7 @@
 
 use std::time::{Duration, Instant};
 
-use meshlight::visibility::workload::{camera_rays, facing_segments};
+use crate::workload::{camera_rays, facing_segments};
 use meshlight::visibility::{Backend, BvhPreset, BvhScene, Hit, Visibility};
 use meshlight::{Result, Scene};
 

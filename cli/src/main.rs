@@ -15,6 +15,8 @@ mod reference;
 mod report;
 mod scale;
 mod sweep;
+mod units;
+mod workload;
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -343,7 +345,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64(),
         memory::peak_bytes().map_or(String::new(), |b| format!(
             ", peak memory {}",
-            meshlight::budget::human_bytes(b as f64)
+            crate::units::bytes(b as f64)
         )),
         r.output.display(),
         png.display()

@@ -467,9 +467,9 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         } else {
             format!("cluster hierarchy, threshold {}", o.cluster_threshold)
         },
-        meshlight::budget::human_bytes(samples_bytes as f64),
-        meshlight::budget::human_bytes(bytes as f64),
-        meshlight::budget::human_bytes(o.memory_budget as f64),
+        crate::units::bytes(samples_bytes as f64),
+        crate::units::bytes(bytes as f64),
+        crate::units::bytes(o.memory_budget as f64),
     );
     let size = crate::ranks::ranks().size();
     if size > 1 {
@@ -486,8 +486,8 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
                 sh.links,
                 sh.most_held_links as f64 / sh.links.max(1) as f64,
                 r.round,
-                meshlight::budget::human_bytes(24.0 * r.samples as f64),
-                meshlight::budget::human_bytes(sh.exchanged_bytes as f64 / exchanges as f64),
+                crate::units::bytes(24.0 * r.samples as f64),
+                crate::units::bytes(sh.exchanged_bytes as f64 / exchanges as f64),
             );
         }
     }

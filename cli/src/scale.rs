@@ -192,8 +192,7 @@ fn row(r: &Run) -> String {
     let _ = write!(
         s,
         " {:>10}",
-        r.peak
-            .map_or("-".into(), |b| meshlight::budget::human_bytes(b as f64))
+        r.peak.map_or("-".into(), |b| crate::units::bytes(b as f64))
     );
     s
 }

@@ -50,7 +50,7 @@ pub(super) fn coefficients(
 ) -> Result<Option<Vec<GridCoefficients>>> {
     let threads = options.lux.threads.max(1);
     let seed = options.solver.seed;
-    let s = &solution.samples;
+    let s = &solution.field.samples;
     let n = s.len();
     let at: Vec<(Vec3, Vec3)> = (0..n).map(|k| (s.position[k], s.normal[k])).collect();
     let ids: Vec<u32> = (0..n as u32).collect();
@@ -189,7 +189,7 @@ fn check_budget(
     bases: usize,
 ) -> Result<()> {
     let points: usize = lit.grids().iter().map(|g| g.points().len()).sum();
-    let samples = solution.samples.len();
+    let samples = solution.field.samples.len();
     let needed = samples * ESCAPE_BYTES_PER_SAMPLE + points * point_bytes(bases);
     let budget = options.solver.memory_budget;
     let left = crate::budget::usable(budget).saturating_sub(solution.bytes());

@@ -204,7 +204,7 @@ fn run(
         grids: Vec::new(),
         sun_hours: Vec::new(),
         left_out: 0,
-        samples: solution.samples.len(),
+        samples: solution.field.samples.len(),
         bases: 0,
         coefficient_bytes: 0,
         stopped: solution.stop() == StopReason::Stopped,

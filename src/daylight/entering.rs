@@ -280,7 +280,7 @@ impl<'a> Entering<'a> {
                     let below = if j == 0 { 0.0 } else { solid[j - 1] };
                     let within = ((pick - below) / (solid[j] - below)).clamp(0.0, 1.0);
                     let p = &self.portals[j];
-                    let at = crate::light::in_triangle(p.vertices, within, u2);
+                    let at = crate::sampling::triangles::in_triangle(p.vertices, within, u2);
                     (at - from).normalize_or_zero()
                 } else {
                     // Cosine-weighted over the receiver's hemisphere.

@@ -11,7 +11,8 @@ pub mod spa;
 mod spa_tables;
 mod view;
 
-pub use site::{AnnualSettings, Daylight, Site, MAX_ILLUMINANCE, SUN_RADIUS_DEGREES};
+pub use site::{AnnualSettings, Daylight, Site, SUN_RADIUS_DEGREES};
+pub use sky::MAX_ILLUMINANCE;
 pub use sky::{Sky, SkyModel};
 pub use spa::{sun_position, LocalTime, Observer, SunPosition};
 pub use view::{sky_view, SkyView};

@@ -3,7 +3,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::sky::Sky;
+use super::sky::{Sky, MAX_ILLUMINANCE};
 use crate::error::{Error, Result};
 
 /// Where a building stands (`[site]`): each key optional, with the defaults scene-format v4
@@ -83,10 +83,6 @@ pub struct Daylight {
     /// The sun's illuminance on a plane facing it (0: no sunlight).
     direct_normal: f64,
 }
-
-/// The largest sky or sun illuminance a site takes: ten times the brightest the Earth sees,
-/// so a unit slip (W/m² for lx, say) passes but an overflow does not.
-pub const MAX_ILLUMINANCE: f64 = 1e6;
 
 /// The sun's apparent radius seen from the Earth: half of 0.533°.
 pub const SUN_RADIUS_DEGREES: f64 = 0.2665;

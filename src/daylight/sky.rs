@@ -11,6 +11,10 @@
 
 use crate::error::{Error, Result};
 
+/// The largest sky or sun illuminance a site takes: ten times the brightest the Earth sees,
+/// so a unit slip (W/m² for lx, say) passes but an overflow does not.
+pub const MAX_ILLUMINANCE: f64 = 1e6;
+
 /// A sky's shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SkyModel {
@@ -301,13 +305,13 @@ impl Sky {
         sun_azimuth: f64,
         diffuse_horizontal: f64,
     ) -> Result<Sky> {
-        if !(0.0..=super::site::MAX_ILLUMINANCE).contains(&diffuse_horizontal) {
+        if !(0.0..=MAX_ILLUMINANCE).contains(&diffuse_horizontal) {
             return Err(Error::Option {
                 option: "sky",
                 problem: format!(
                     "diffuse_horizontal {} is not an illuminance in 0 to {:e}",
                     super::human(diffuse_horizontal),
-                    super::site::MAX_ILLUMINANCE
+                    MAX_ILLUMINANCE
                 ),
             });
         }

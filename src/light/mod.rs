@@ -17,6 +17,7 @@ use rand_pcg::Pcg64Mcg;
 use crate::error::Result;
 use crate::parallel::{for_chunks_reporting, Report};
 use crate::sampling::poisson::side_seed;
+use crate::sampling::triangles::{cumulative_area, in_triangle};
 use crate::scene::{PointSource, Scene};
 use crate::specular::images::{self, Chain};
 use crate::specular::shadow::{self, LightPath};
@@ -65,25 +66,6 @@ pub(crate) fn lattice(s: u32, count: u32, shift: (f64, f64)) -> (f64, f64) {
     let u1 = ((f64::from(s) + 0.5) / f64::from(count) + shift.0).fract();
     let u2 = (f64::from(s) * GOLDEN + shift.1).fract();
     (u1, u2)
-}
-
-/// The point of triangle `[a, b, c]` at (u1, u2) in the unit square, uniform over its area.
-pub(crate) fn in_triangle([a, b, c]: [Vec3; 3], u1: f64, u2: f64) -> Vec3 {
-    let (r1, r2) = (u1.sqrt() as f32, u2 as f32);
-    a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
-}
-
-/// The running sum of the triangles' areas: a triangle is picked by area where it passes a
-/// uniform number × the total (the last entry).
-pub(crate) fn cumulative_area(triangles: &[&crate::scene::Triangle]) -> Vec<f64> {
-    let mut total = 0.0;
-    triangles
-        .iter()
-        .map(|t| {
-            total += f64::from(t.area);
-            total
-        })
-        .collect()
 }
 
 /// The sphere around some triangles: their vertices' mean and the farthest vertex from it.

@@ -13,9 +13,9 @@
 
 use glam::{DVec3, Vec3};
 
-use super::interpolate::Site;
 use super::{Pending, Shader};
 use crate::error::Result;
+use crate::field::interpolate::Site;
 use crate::sampling::side_of;
 use crate::visibility::{Hit, Ray, Segment};
 

@@ -10,12 +10,13 @@
 
 mod gather;
 pub(crate) mod image;
-pub(crate) mod interpolate;
 mod paths;
 
 use glam::Vec3;
 
 use crate::error::Result;
+use crate::field::interpolate::{self, Interpolator, Site};
+use crate::field::Field;
 use crate::light::{DirectLight, Reach};
 use crate::progress::{Callback, Control, Phase, Progress, Reporter};
 use crate::sampling::{side_of, surface_of, Side};
@@ -24,7 +25,6 @@ use crate::solver::Solution;
 use crate::visibility::{Hit, Ray, Visibility};
 pub use gather::MAX_GATHER_RAYS;
 pub use image::Image;
-use interpolate::{Interpolator, Site};
 
 /// Edge pixels of high contrast get up to this many times `supersample` rays per side.
 const MAX_EDGE_BOOST: usize = 4;
@@ -256,7 +256,7 @@ pub fn render_distributed(
             crate::budget::BYTES_PER_PIXEL,
         )?;
         let (w, h) = (camera.width as usize, camera.height as usize);
-        let shader = Shader::new(scene, solution, vis, options);
+        let shader = Shader::new(scene, &solution.field, vis, options);
         let mut stats = RenderStats::default();
         let mut reporter = Reporter::new(progress);
         let base = Progress {
@@ -585,15 +585,15 @@ struct Pending {
 impl<'a> Shader<'a> {
     fn new(
         scene: &'a Scene,
-        solution: &'a Solution,
+        field: &'a Field,
         vis: &'a dyn Visibility,
         options: &RenderOptions,
     ) -> Self {
-        let s = &solution.samples;
+        let s = &field.samples;
         let light = match options.direct {
             // A solution without its samples' direct light cannot be split.
-            Direct::Traced { light_samples } if solution.direct.len() == s.len() => Some(
-                DirectLight::reaching(scene, light_samples, solution.specular_depth, Reach::Near),
+            Direct::Traced { light_samples } if field.direct.len() == s.len() => Some(
+                DirectLight::reaching(scene, light_samples, field.specular_depth, Reach::Near),
             ),
             _ => None,
         };
@@ -603,7 +603,7 @@ impl<'a> Shader<'a> {
         let shown = |k: usize, direct: glam::DVec3| match options.quantity {
             Quantity::Radiance => {
                 let rho = crate::solver::reflectance_of(scene, s, k);
-                let reflected = solution.radiosity[k] - rho * direct;
+                let reflected = field.radiosity[k] - rho * direct;
                 if scene.is_textured(crate::sampling::surface_of(s.side[k])) {
                     let e = crate::solver::emission_of(scene, s, k);
                     per_unit(reflected - e, rho) / std::f64::consts::PI
@@ -611,12 +611,12 @@ impl<'a> Shader<'a> {
                     reflected / std::f64::consts::PI
                 }
             }
-            Quantity::Irradiance => solution.irradiance[k] - direct,
+            Quantity::Irradiance => field.irradiance[k] - direct,
         };
         let values = (0..s.len())
             .map(|k| {
                 let direct = match light {
-                    Some(_) => solution.direct[k].irradiance,
+                    Some(_) => field.direct[k].irradiance,
                     None => glam::DVec3::ZERO,
                 };
                 shown(k, direct)
@@ -631,10 +631,9 @@ impl<'a> Shader<'a> {
                 .map(|k| {
                     // Per unit reflectance: each gather hit multiplies by its own.
                     let rho = crate::solver::reflectance_of(scene, s, k);
-                    let direct = solution.direct[k].irradiance;
-                    let reflected = solution.radiosity[k]
-                        - crate::solver::emission_of(scene, s, k)
-                        - rho * direct;
+                    let direct = field.direct[k].irradiance;
+                    let reflected =
+                        field.radiosity[k] - crate::solver::emission_of(scene, s, k) - rho * direct;
                     (
                         direct / std::f64::consts::PI,
                         per_unit(reflected, rho) / std::f64::consts::PI,
@@ -648,7 +647,7 @@ impl<'a> Shader<'a> {
             Direct::Traced { light_samples } if light.is_some() => Some(DirectLight::reaching(
                 scene,
                 (light_samples * PENUMBRA_RAYS).min(crate::light::MAX_LIGHT_SAMPLES),
-                solution.specular_depth,
+                field.specular_depth,
                 Reach::Near,
             )),
             _ => None,
@@ -656,27 +655,23 @@ impl<'a> Shader<'a> {
         Shader {
             scene,
             vis,
-            interpolator: Interpolator::new(scene, solution, vis),
+            interpolator: Interpolator::new(scene, field, vis),
             quantity: options.quantity,
             values,
             full,
             outgoing,
             gather_rays: options.gather_rays,
             near_light: gathers.then(|| {
-                DirectLight::with_specular(
-                    scene,
-                    gather::NEAR_LIGHT_SAMPLES,
-                    solution.specular_depth,
-                )
+                DirectLight::with_specular(scene, gather::NEAR_LIGHT_SAMPLES, field.specular_depth)
             }),
             light,
             penumbra,
             paths: {
                 let spec = crate::specular::Specular::of(scene);
-                (spec.any() && solution.specular_depth > 0).then(|| paths::Paths {
+                (spec.any() && field.specular_depth > 0).then(|| paths::Paths {
                     lights: crate::specular::lights::Lights::new(scene),
                     spec,
-                    depth: solution.specular_depth,
+                    depth: field.specular_depth,
                     glossy_rays: options.glossy_rays,
                 })
             },

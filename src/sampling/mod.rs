@@ -9,6 +9,7 @@ pub mod poisson;
 pub(crate) mod reflectance;
 pub(crate) mod shares;
 pub mod surface_map;
+pub(crate) mod triangles;
 
 use glam::{Vec2, Vec3};
 

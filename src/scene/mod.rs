@@ -438,7 +438,7 @@ impl Scene {
             },
             None => (file.solver.max_reflectance).unwrap_or(DEFAULT_MAX_REFLECTANCE),
         };
-        let rules = obj::Rules {
+        let rules = mtl::Rules {
             max_reflectance,
             strict: options.strict,
         };
@@ -544,7 +544,7 @@ impl Scene {
     fn read_obj(
         files: &dyn Source,
         obj_path: &Path,
-        rules: &obj::Rules,
+        rules: &mtl::Rules,
         notes: &[String],
         (path, line): (&Path, usize),
     ) -> Result<(Mesh, Vec<String>)> {

@@ -9,10 +9,21 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::obj::{read_text, Rules};
+use super::source::read_text;
 use super::validate::{self, MaterialField};
 use super::{Kind, Material, Texture};
 use crate::error::{Error, Result};
+
+/// Reflectance given to faces that name no material (`docs/scene-format.md`).
+pub(super) const DEFAULT_KD: f32 = 0.5;
+
+/// What the scene format leaves to the reader: reflectances of exactly 1.
+pub(super) struct Rules {
+    /// What a Kd channel of exactly 1 is lowered to.
+    pub max_reflectance: f32,
+    /// Whether such a channel is an error instead.
+    pub strict: bool,
+}
 
 /// An MTL file reduced to `newmtl`, `Kd` and `Ke`, with where each material's lines are.
 pub(super) struct MtlLibrary {
@@ -557,8 +568,8 @@ fn texture_of(
             let fallback = if has_kd {
                 "the material keeps its Kd".to_string()
             } else {
-                material.kd = Vec3::splat(super::obj::DEFAULT_KD);
-                format!("the material gets Kd = {} grey", super::obj::DEFAULT_KD)
+                material.kd = Vec3::splat(DEFAULT_KD);
+                format!("the material gets Kd = {} grey", DEFAULT_KD)
             };
             warnings.push(format!(
                 "{}:{}: material '{}': texture {} cannot be read ({problem}): {fallback}",

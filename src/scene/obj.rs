@@ -14,13 +14,11 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use super::mtl::{materials_from, read_mtl, MtlLibrary, UvTransform};
+use super::mtl::{materials_from, read_mtl, MtlLibrary, Rules, UvTransform, DEFAULT_KD};
+use super::source::read_text;
 use super::validate;
 use super::{Material, Mesh};
 use crate::error::{Error, Result};
-
-/// Reflectance given to faces that name no material (`docs/scene-format.md`).
-pub(super) const DEFAULT_KD: f32 = 0.5;
 
 const OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
     single_index: false,
@@ -28,14 +26,6 @@ const OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
     ignore_points: true,
     ignore_lines: true,
 };
-
-/// What the scene format leaves to the reader: reflectances of exactly 1.
-pub(super) struct Rules {
-    /// What a Kd channel of exactly 1 is lowered to.
-    pub max_reflectance: f32,
-    /// Whether such a channel is an error instead.
-    pub strict: bool,
-}
 
 /// Reads an OBJ file and the MTL files it names; returns the mesh and warnings.
 pub(super) fn read(
@@ -216,28 +206,6 @@ fn texcoords(
     } else {
         Vec::new()
     }
-}
-
-/// Reads a whole file as UTF-8 text; errors name the file and, for bad UTF-8, the line.
-pub(super) fn read_text(files: &dyn super::Source, path: &Path) -> Result<String> {
-    let bytes = files.read(path).map_err(|source| Error::Read {
-        path: path.into(),
-        cause: source,
-    })?;
-    // A UTF-8 byte-order mark (some Windows tools write one) is not part of the first line.
-    let bytes = match bytes.strip_prefix(b"\xEF\xBB\xBF") {
-        Some(rest) => rest.to_vec(),
-        None => bytes,
-    };
-    String::from_utf8(bytes).map_err(|e| {
-        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
-        Error::scene(
-            path,
-            Some(line),
-            "not valid UTF-8 text (is this a binary file?)",
-        )
-    })
 }
 
 /// The OBJ text reduced to what tobj needs, and what the check learnt.

@@ -5,6 +5,8 @@ use std::collections::HashMap;
 use std::io;
 use std::path::{Path, PathBuf};
 
+use crate::error::{Error, Result};
+
 /// Reads the bytes of a file a scene refers to.
 pub trait Source {
     /// The whole file.
@@ -51,4 +53,26 @@ impl Source for Memory {
             .cloned()
             .ok_or_else(|| io::Error::new(io::ErrorKind::NotFound, "no such file"))
     }
+}
+
+/// Reads a whole file as UTF-8 text; errors name the file and, for bad UTF-8, the line.
+pub(super) fn read_text(files: &dyn Source, path: &Path) -> Result<String> {
+    let bytes = files.read(path).map_err(|source| Error::Read {
+        path: path.into(),
+        cause: source,
+    })?;
+    // A UTF-8 byte-order mark (some Windows tools write one) is not part of the first line.
+    let bytes = match bytes.strip_prefix(b"\xEF\xBB\xBF") {
+        Some(rest) => rest.to_vec(),
+        None => bytes,
+    };
+    String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+        Error::scene(
+            path,
+            Some(line),
+            "not valid UTF-8 text (is this a binary file?)",
+        )
+    })
 }

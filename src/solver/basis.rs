@@ -43,16 +43,21 @@ impl<'a> Basis<'a> {
         options: &'a Options,
         stop: &mut dyn FnMut() -> bool,
     ) -> Result<Option<Basis<'a>>> {
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         let mut basis = Basis {
             scene,
             solution,
             vis,
             options,
             reflectance: (0..n)
-                .map(|k| super::reflectance(scene, &solution.samples, k))
+                .map(|k| super::reflectance(scene, &solution.field.samples, k))
                 .collect(),
-            dark_emitters: solution.direct.iter().map(|a| a.dark_emitters).collect(),
+            dark_emitters: solution
+                .field
+                .direct
+                .iter()
+                .map(|a| a.dark_emitters)
+                .collect(),
             linked: None,
             row_scale: solution.row_scale.clone(),
         };
@@ -64,10 +69,10 @@ impl<'a> Basis<'a> {
         let mut ledger = EnergyLedger::default();
         let mut row_scale = solution.row_scale.clone();
         let mut state = State {
-            samples: &solution.samples,
-            maps: &solution.maps,
+            samples: &solution.field.samples,
+            maps: solution.field.layout.maps(),
             reflectance: &basis.reflectance,
-            radiosity: &solution.radiosity,
+            radiosity: &solution.field.radiosity,
             irradiance: &mut irradiance,
             unshot: &mut unshot,
             ledger: &mut ledger,
@@ -80,8 +85,8 @@ impl<'a> Basis<'a> {
         let cx = Context {
             scene,
             grid: &grid,
-            samples: &solution.samples,
-            obstruction: &solution.obstruction,
+            samples: &solution.field.samples,
+            obstruction: solution.field.layout.obstruction(),
             lift: settings.lift,
         };
         let mut report = |_: Tick| {
@@ -101,7 +106,7 @@ impl<'a> Basis<'a> {
 
     fn settings(&self) -> Settings<'static> {
         let options = self.options;
-        let n = self.solution.samples.len();
+        let n = self.solution.field.samples.len();
         let hierarchical = !options.flat();
         Settings {
             ranks: &crate::distributed::Single,
@@ -136,7 +141,7 @@ impl<'a> Basis<'a> {
         stop: &mut dyn FnMut() -> bool,
     ) -> Result<(Vec<DVec3>, ShootStats)> {
         let solution = self.solution;
-        let samples = &solution.samples;
+        let samples = &solution.field.samples;
         let n = samples.len();
         debug_assert_eq!(first.len(), n);
         let settings = self.settings();
@@ -151,7 +156,7 @@ impl<'a> Basis<'a> {
         let mut row_scale = self.row_scale.clone();
         let mut state = State {
             samples,
-            maps: &solution.maps,
+            maps: solution.field.layout.maps(),
             reflectance: rho,
             radiosity: &radiosity,
             irradiance: &mut irradiance,

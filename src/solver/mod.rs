@@ -28,12 +28,13 @@ use glam::DVec3;
 pub use crate::area::AreaStats;
 use crate::budget::{human_bytes, human_count, human_number, BYTES_PER_SAMPLE};
 use crate::error::{Error, Result};
+use crate::field::{Field, Layout};
 pub use crate::light::Arrival;
 use crate::light::{DirectLight, Reach};
 use crate::progress::Reporter;
 pub use crate::progress::{Control, Phase, Progress};
 pub use crate::sampling::Samples;
-use crate::sampling::{reflecting_sides, surface_of, Obstruction, SideIndex, SurfaceMap};
+use crate::sampling::{reflecting_sides, surface_of, Obstruction, SurfaceMap};
 use crate::scene::Scene;
 pub use crate::specular::{summary as specular_summary, SpecularSummary, MAX_SPECULAR_DEPTH};
 use crate::visibility::Visibility;
@@ -48,55 +49,43 @@ pub(crate) use warm::emission as emission_of;
 pub(crate) use warm::reflectance as reflectance_of;
 use warm::reflectance;
 
-/// The solved samples: read-only results (the solver alone builds one).
+/// A solve's outcome: the solved [`Field`] (the samples and their light, which the render and
+/// the grids read) and what only the solver uses (unshot light, row scales, the specular
+/// transfer) or reports (rounds, the energy ledger). Read-only; the solver alone builds one.
 #[derive(Clone, Debug)]
 pub struct Solution {
-    pub(crate) samples: Samples,
-    pub(crate) radiosity: Vec<DVec3>,
-    pub(crate) irradiance: Vec<DVec3>,
+    pub(crate) field: Field,
     pub(crate) unshot: Vec<DVec3>,
-    pub(crate) direct: Vec<Arrival>,
-    pub(crate) epsilon: f32,
     pub(crate) epsilon_source: EpsilonSource,
-    /// The specular depth solved with (the render and the grids light with the same).
-    pub(crate) specular_depth: u32,
     pub(crate) rounds: Vec<RoundStats>,
     pub(crate) ledger: EnergyLedger,
-    // What the solver and renderer need beyond the results: kept with them, not shown.
-    /// The surfaces in 2D (for interpolation).
-    pub(crate) maps: Vec<SurfaceMap>,
-    /// Range queries over the samples.
-    pub(crate) index: SideIndex,
-    /// Which sides other geometry stands on.
-    pub(crate) obstruction: Obstruction,
     /// Per sample: whether all its probe rays hit the scene (a closed hemisphere).
     pub(crate) closed: Vec<bool>,
-    /// Per sample: whether something hovers over it (see `sampling::cover`).
-    pub(crate) covered: Vec<bool>,
     /// Per sample: the factor its received form factors are scaled by (row normalisation).
     pub(crate) row_scale: Vec<f32>,
     /// Light by way of specular surfaces (none in a scene without them).
     pub(crate) specular: Option<specular::Transfer>,
-    /// Per sample: the daylight entering straight from the sky and the ground (empty without
-    /// daylight). Exact at each sample, not interpolated in warm starts; the image interpolates
-    /// it with the rest of the samples' light.
-    pub(crate) daylight: Vec<DVec3>,
 }
 
 impl Solution {
     /// The samples (positions, normals, sides, radii, areas).
     pub fn samples(&self) -> &Samples {
-        &self.samples
+        &self.field.samples
+    }
+
+    /// The solved field: the samples and their light, as the render and the grids read it.
+    pub fn field(&self) -> &Field {
+        &self.field
     }
 
     /// Radiosity B of each sample (W/m², RGB): emission π·Ke plus reflected light.
     pub fn radiosity(&self) -> &[DVec3] {
-        &self.radiosity
+        &self.field.radiosity
     }
 
     /// Irradiance at each sample (direct + inter-reflected).
     pub fn irradiance(&self) -> &[DVec3] {
-        &self.irradiance
+        &self.field.irradiance
     }
 
     /// Unshot radiosity left at each sample.
@@ -106,12 +95,12 @@ impl Solution {
 
     /// Direct light at each sample.
     pub fn direct(&self) -> &[Arrival] {
-        &self.direct
+        &self.field.direct
     }
 
     /// The Poisson-disk spacing ε used.
     pub fn epsilon(&self) -> f32 {
-        self.epsilon
+        self.field.epsilon()
     }
 
     /// Where ε came from.
@@ -152,22 +141,24 @@ impl Solution {
     /// The bytes the solution holds, by part.
     pub fn memory(&self) -> crate::budget::Breakdown {
         use crate::sampling::vec_bytes;
-        let (samples, cells, shares) = self.samples.bytes();
+        let f = &self.field;
+        let (samples, cells, shares) = f.samples.bytes();
+        let (index, covered, maps) = f.layout.bytes();
         crate::budget::Breakdown {
             samples,
             cells,
             shares,
-            index: self.index.bytes(),
-            results: vec_bytes(&self.radiosity)
-                + vec_bytes(&self.irradiance)
+            index,
+            results: vec_bytes(&f.radiosity)
+                + vec_bytes(&f.irradiance)
                 + vec_bytes(&self.unshot)
-                + vec_bytes(&self.direct)
+                + vec_bytes(&f.direct)
                 + vec_bytes(&self.closed)
-                + vec_bytes(&self.covered)
+                + covered
                 + vec_bytes(&self.row_scale)
-                + vec_bytes(&self.daylight),
+                + vec_bytes(&f.daylight),
             specular: self.specular.as_ref().map_or(0, specular::Transfer::bytes),
-            maps: self.maps.iter().map(|m| vec_bytes(&m.triangles)).sum(),
+            maps,
         }
     }
 
@@ -175,7 +166,9 @@ impl Solution {
     /// tile every sampled side, consistent shares and index): the first one broken, in words.
     /// The solver checks them itself in debug builds.
     pub fn validate(&self) -> std::result::Result<(), String> {
-        self.samples.validate(&self.maps, &self.index)
+        self.field
+            .samples
+            .validate(self.field.layout.maps(), self.field.layout.index())
     }
 
     /// Whether this solution belongs to `scene` and its arrays agree with each other: an
@@ -183,13 +176,13 @@ impl Solution {
     /// solution of another scene (or one a host has edited) fails cleanly.
     pub fn check_fits(&self, scene: &Scene) -> Result<()> {
         let fail = |problem: String| Err(Error::argument("solution", problem));
-        let s = &self.samples;
+        let s = &self.field.samples;
         let n = s.len();
         let sides = 2 * scene.surfaces.len();
-        if self.maps.len() != scene.surfaces.len() {
+        if self.field.layout.maps().len() != scene.surfaces.len() {
             return fail(format!(
                 "solved for {} surfaces, the scene has {}",
-                self.maps.len(),
+                self.field.layout.maps().len(),
                 scene.surfaces.len()
             ));
         }
@@ -199,10 +192,10 @@ impl Solution {
             ("sides", s.side.len()),
             ("radii", s.radius.len()),
             ("areas", s.area.len()),
-            ("radiosities", self.radiosity.len()),
-            ("irradiances", self.irradiance.len()),
+            ("radiosities", self.field.radiosity.len()),
+            ("irradiances", self.field.irradiance.len()),
             ("unshot", self.unshot.len()),
-            ("direct", self.direct.len()),
+            ("direct", self.field.direct.len()),
         ];
         if let Some((name, len)) = lengths.iter().find(|(_, len)| *len != n) {
             return fail(format!("{len} {name} for {n} samples"));
@@ -212,7 +205,7 @@ impl Solution {
                 "a sample on side {side}; the scene has {sides} sides"
             ));
         }
-        if !self.index.fits(sides, n) {
+        if !self.field.layout.index().fits(sides, n) {
             return fail("its sample index does not match its samples".into());
         }
         // The samples lie on their surfaces' planes (a solution of the scene at another scale or
@@ -256,10 +249,10 @@ impl Solution {
 
     /// Power absorbed by the surfaces: Σ (1 − ρ) H S.
     pub fn absorbed(&self, scene: &Scene) -> DVec3 {
-        (0..self.samples.len())
+        (0..self.field.samples.len())
             .map(|k| {
-                let rho = reflectance(scene, &self.samples, k);
-                (DVec3::ONE - rho) * self.irradiance[k] * self.samples.area[k]
+                let rho = reflectance(scene, &self.field.samples, k);
+                (DVec3::ONE - rho) * self.field.irradiance[k] * self.field.samples.area[k]
             })
             .sum()
     }
@@ -268,7 +261,7 @@ impl Solution {
     pub fn unshot_power(&self) -> DVec3 {
         self.unshot
             .iter()
-            .zip(&self.samples.area)
+            .zip(&self.field.samples.area)
             .map(|(&u, &a)| u * a)
             .sum()
     }
@@ -458,33 +451,32 @@ fn solve_with(
     let t = Instant::now();
     let samples = solve.initial_samples(&maps)?;
     let mut solution = Solution {
-        samples,
-        radiosity: Vec::new(),
-        irradiance: Vec::new(),
+        field: Field {
+            samples,
+            radiosity: Vec::new(),
+            irradiance: Vec::new(),
+            direct: Vec::new(),
+            daylight: Vec::new(),
+            specular_depth: options.specular_depth,
+            specular: solve.specular.is_some(),
+            layout: Layout::new(epsilon, maps, obstruction),
+        },
         unshot: Vec::new(),
-        direct: Vec::new(),
-        epsilon,
         epsilon_source,
-        specular_depth: options.specular_depth,
         rounds: Vec::new(),
         ledger: EnergyLedger {
             emitted: scene.emitted_power(),
             ..EnergyLedger::default()
         },
-        maps,
-        index: SideIndex::default(),
-        obstruction,
         closed: Vec::new(),
-        covered: Vec::new(),
         row_scale: Vec::new(),
-        daylight: Vec::new(),
         specular: solve
             .specular
             .as_ref()
             .map(|_| specular::Transfer::default()),
     };
     let mut added = AddedSamples {
-        added: solution.samples.len(),
+        added: solution.field.samples.len(),
         refined: 0,
         capped: false,
         seconds: t.elapsed().as_secs_f64(),
@@ -527,7 +519,7 @@ pub fn transfer(
         let checked = crate::visibility::Checked::new(vis, scene);
         let vis: &dyn crate::visibility::Visibility = &checked;
         solution.check_fits(scene)?;
-        let (samples, maps) = (&solution.samples, &solution.maps);
+        let (samples, maps) = (&solution.field.samples, solution.field.layout.maps());
         if let Some(&j) = shooters.iter().find(|&&j| j as usize >= samples.len()) {
             return Err(Error::argument(
                 "shooters",
@@ -689,13 +681,24 @@ mod tests {
             shooting.links, shooting.leaf_links,
             "every link joins two samples"
         );
-        assert_eq!(flat.samples, tree.samples);
+        assert_eq!(flat.field.samples, tree.field.samples);
         for (a, b) in flat.row_scale.iter().zip(&tree.row_scale) {
             assert!((a - b).abs() <= 1e-6 * a.abs(), "row scales {a} vs {b}");
         }
-        let mean = flat.radiosity.iter().map(|b| b.element_sum()).sum::<f64>()
-            / (3 * flat.radiosity.len()) as f64;
-        for (k, (a, b)) in flat.radiosity.iter().zip(&tree.radiosity).enumerate() {
+        let mean = flat
+            .field
+            .radiosity
+            .iter()
+            .map(|b| b.element_sum())
+            .sum::<f64>()
+            / (3 * flat.field.radiosity.len()) as f64;
+        for (k, (a, b)) in flat
+            .field
+            .radiosity
+            .iter()
+            .zip(&tree.field.radiosity)
+            .enumerate()
+        {
             assert!(
                 (*a - *b).abs().max_element() <= 1e-6 * mean,
                 "sample {k}: flat {a} vs hierarchy {b}"
@@ -713,22 +716,22 @@ mod tests {
         };
         let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
         assert_eq!(s.validate(), Ok(()));
-        assert!(s.samples.round.contains(&1), "adaptive samples too");
+        assert!(s.field.samples.round.contains(&1), "adaptive samples too");
         // Two samples of one side closer than their radii.
         let mut broken = s.clone();
-        let (a, b) = (0..broken.samples.len())
-            .flat_map(|a| (a + 1..broken.samples.len()).map(move |b| (a, b)))
-            .find(|&(a, b)| broken.samples.side[a] == broken.samples.side[b])
+        let (a, b) = (0..broken.field.samples.len())
+            .flat_map(|a| (a + 1..broken.field.samples.len()).map(move |b| (a, b)))
+            .find(|&(a, b)| broken.field.samples.side[a] == broken.field.samples.side[b])
             .unwrap();
-        broken.samples.uv[b] = broken.samples.uv[a] + glam::Vec2::splat(1e-4);
-        broken.index = SideIndex::new(&broken.samples, &broken.maps, s.epsilon);
+        broken.field.samples.uv[b] = broken.field.samples.uv[a] + glam::Vec2::splat(1e-4);
+        broken.field.layout.reindex(&broken.field.samples);
         assert!(broken
             .validate()
             .unwrap_err()
             .contains("closer than their radii"));
         // A sample's area that is not its shares'.
         let mut broken = s.clone();
-        broken.samples.area[3] *= 1.01;
+        broken.field.samples.area[3] *= 1.01;
         assert!(broken
             .validate()
             .unwrap_err()
@@ -736,10 +739,10 @@ mod tests {
         // Shares that do not tile the cells.
         let mut broken = s.clone();
         // (The largest share, so that the cell's sum moves by more than the tolerance.)
-        let units = &broken.samples.shares.units;
+        let units = &broken.field.samples.shares.units;
         let largest = (0..units.len()).max_by_key(|&i| units[i]).unwrap();
         let half = units[largest] / 2;
-        broken.samples.shares.set_units(largest, half);
+        broken.field.samples.shares.set_units(largest, half);
         let e = broken.validate().unwrap_err();
         assert!(
             e.contains("is not its shares'") || e.contains("shared out"),
@@ -747,7 +750,7 @@ mod tests {
         );
         // A sample the index does not hold.
         let mut broken = s.clone();
-        broken.index = SideIndex::default();
+        broken.field.layout.forget_index();
         assert!(broken
             .validate()
             .unwrap_err()
@@ -766,20 +769,20 @@ mod tests {
         let cx = Context {
             scene,
             grid: &grid,
-            samples: &s.samples,
-            obstruction: &s.obstruction,
+            samples: &s.field.samples,
+            obstruction: s.field.layout.obstruction(),
             lift: crate::visibility::lift(scene),
         };
-        let n = s.samples.len();
-        let tree = cluster::tree::Tree::build(&s.samples, &vec![0.5; n], &vec![1.0; n], &cx);
+        let n = s.field.samples.len();
+        let tree = cluster::tree::Tree::build(&s.field.samples, &vec![0.5; n], &vec![1.0; n], &cx);
         (s, tree)
     }
 
     #[test]
     fn the_cluster_tree_is_valid_and_its_check_catches_broken_trees() {
         let (s, tree) = solve_and_tree(&small_room(), 1);
-        let n = s.samples.len();
-        assert_eq!(tree.validate(&s.samples), Ok(()));
+        let n = s.field.samples.len();
+        assert_eq!(tree.validate(&s.field.samples), Ok(()));
         assert_eq!(tree.nodes.len(), n - 1);
         // Nodes over several sides near the top, single-side subtrees below, and incoherent
         // nodes where the boxes stand on the floor.
@@ -790,14 +793,17 @@ mod tests {
         assert!(tree.nodes.iter().any(|node| !node.coherent));
         let mut broken = tree.clone();
         broken.nodes[0].area *= 1.01;
-        assert!(broken.validate(&s.samples).unwrap_err().contains("totals"));
+        assert!(broken
+            .validate(&s.field.samples)
+            .unwrap_err()
+            .contains("totals"));
         let mut broken = tree.clone();
         let last = broken.nodes.len() - 1;
         broken.nodes[last].radius *= 0.5;
-        assert!(broken.validate(&s.samples).is_err());
+        assert!(broken.validate(&s.field.samples).is_err());
         let mut broken = tree;
         broken.order.swap(0, n - 1);
-        assert!(broken.validate(&s.samples).is_err());
+        assert!(broken.validate(&s.field.samples).is_err());
     }
 
     #[test]
@@ -811,10 +817,10 @@ mod tests {
         )
         .unwrap();
         let (s, tree) = solve_and_tree(&scene, 0);
-        let n = s.samples.len();
+        let n = s.field.samples.len();
         let (mut hovered, mut checked) = (0, 0);
         for k in 0..n {
-            let (p, d) = (s.samples.position[k], s.samples.radius[k]);
+            let (p, d) = (s.field.samples.position[k], s.field.samples.radius[k]);
             let gap = |c: f32| (c - 2.0).abs() - 0.5 - d;
             let on_ceiling = (p.y - 3.0).abs() < 1e-4;
             // Boxes that just touch the square are left out: a rounding either way is right.

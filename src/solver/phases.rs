@@ -17,9 +17,7 @@ use crate::light::{Arrival, DirectLight};
 use crate::parallel::for_chunks_reporting;
 use crate::progress::{Control, Phase, Progress, Reporter};
 use crate::sampling::adaptive::{self, RefineSettings};
-use crate::sampling::{
-    cover, poisson, reflecting_sides, surface_of, Samples, SideIndex, SurfaceMap,
-};
+use crate::sampling::{cover, poisson, reflecting_sides, surface_of, Samples, SurfaceMap};
 use crate::scene::Scene;
 use crate::specular::lights::Lights;
 use crate::specular::Specular;
@@ -182,7 +180,7 @@ impl Solve<'_> {
             sampling: added.seconds,
             ..PhaseSeconds::default()
         };
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         let first_new = n - added.added;
 
         let t = Instant::now();
@@ -212,8 +210,9 @@ impl Solve<'_> {
             seconds.shooting = total + probe_seconds;
         }
         for k in 0..n {
-            solution.radiosity[k] = emission(self.scene, &solution.samples, k)
-                + reflectance(self.scene, &solution.samples, k) * solution.irradiance[k];
+            solution.field.radiosity[k] = emission(self.scene, &solution.field.samples, k)
+                + reflectance(self.scene, &solution.field.samples, k)
+                    * solution.field.irradiance[k];
         }
         Ok(RoundStats {
             round,
@@ -236,25 +235,25 @@ impl Solve<'_> {
         round: u32,
         added: &AddedSamples,
     ) -> Result<AreaStats> {
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         self.begin(Phase::Areas, round, n);
-        solution.index = SideIndex::new(&solution.samples, &solution.maps, self.epsilon);
+        solution.field.layout.reindex(&solution.field.samples);
         let base = self.base(Phase::Areas, round, n);
         let stats = area::compute(
-            &mut solution.samples,
-            &solution.maps,
-            &solution.index,
-            &solution.obstruction,
+            &mut solution.field.samples,
+            solution.field.layout.maps(),
+            solution.field.layout.index(),
+            solution.field.layout.obstruction(),
             self.vis,
             (self.epsilon, self.options.alpha),
             (self.options.threads.max(1), self.ranks),
             added.changed.as_deref(),
             &mut self.reporter.part(base),
         )?;
-        solution.samples.reflectance = crate::sampling::reflectance::means(
+        solution.field.samples.reflectance = crate::sampling::reflectance::means(
             self.scene,
-            &solution.samples,
-            &solution.maps,
+            &solution.field.samples,
+            solution.field.layout.maps(),
             self.options.threads.max(1),
         )?;
         debug_assert_eq!(solution.validate(), Ok(()));
@@ -273,7 +272,7 @@ impl Solve<'_> {
         if !balance::closed_to_the_lights(self.scene, self.vis, self.lift, settings)? {
             return Ok(DVec3::ONE);
         }
-        let area = &solution.samples.area;
+        let area = &solution.field.samples.area;
         let received: DVec3 = arrivals
             .iter()
             .zip(area)
@@ -292,9 +291,9 @@ impl Solve<'_> {
     ) -> Result<u64> {
         let (scene, vis, options) = (self.scene, self.vis, self.options);
         let threads = options.threads.max(1);
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         self.begin(Phase::DirectLight, round, n);
-        let s = &solution.samples;
+        let s = &solution.field.samples;
         let points: Vec<(Vec3, Vec3)> = (first_new..n)
             .map(|k| (s.position[k], s.normal[k]))
             .collect();
@@ -326,8 +325,7 @@ impl Solve<'_> {
         for a in &mut arrivals {
             a.irradiance *= self.light_scale;
         }
-        solution.covered.reserve_exact(covered.len());
-        solution.covered.extend(covered);
+        solution.field.layout.cover(&covered);
         let at = (points.as_slice(), ids.as_slice());
         queries += self.specular_light(solution, round, first_new, at)?;
         queries += self.daylight(solution, round, at)?;
@@ -341,16 +339,16 @@ impl Solve<'_> {
             options.alpha,
             (threads, self.ranks),
         )?;
-        if round == 0 && !solution.daylight.is_empty() {
+        if round == 0 && !solution.field.daylight.is_empty() {
             // Daylight is a source too: what enters is what the shooting measures against (the
             // sky's and the ground's, and the sun's, which the samples' direct light holds
             // mixed with the lamps': measured on its own here).
             let mut entering: DVec3 = (0..n)
-                .map(|k| solution.daylight[k] * solution.samples.area[k])
+                .map(|k| solution.field.daylight[k] * solution.field.samples.area[k])
                 .sum();
             if let Some(sun) = DirectLight::sun_only(scene, options.light_samples) {
                 if !self.reporter.stopped() {
-                    let s = &solution.samples;
+                    let s = &solution.field.samples;
                     let points: Vec<(Vec3, Vec3)> =
                         (0..n).map(|k| (s.position[k], s.normal[k])).collect();
                     let ids: Vec<u32> = (0..n as u32).collect();
@@ -371,9 +369,9 @@ impl Solve<'_> {
             // Direct light that reached no sample area left the scene.
             let received: DVec3 = (0..n)
                 .map(|k| {
-                    let exact =
-                        solution.direct[k].irradiance + warm::exact_beyond_direct(solution, k);
-                    exact * solution.samples.area[k]
+                    let exact = solution.field.direct[k].irradiance
+                        + warm::exact_beyond_direct(solution, k);
+                    exact * solution.field.samples.area[k]
                 })
                 .sum();
             solution.ledger.escaped += solution.ledger.emitted - received;
@@ -391,10 +389,10 @@ impl Solve<'_> {
         let Some(entering) = &self.entering else {
             return Ok(0);
         };
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         let mut out = vec![DVec3::ZERO; points.len()];
         if self.reporter.stopped() {
-            solution.daylight.extend(out);
+            solution.field.daylight.extend(out);
             return Ok(0);
         }
         let (vis, seed) = (self.vis, self.options.seed);
@@ -409,7 +407,7 @@ impl Solve<'_> {
         let base = self.base(Phase::DirectLight, round, n);
         let threads = self.options.threads.max(1);
         for_chunks_reporting(&mut out, 64, threads, work, &mut self.reporter.part(base))?;
-        solution.daylight.extend(out);
+        solution.field.daylight.extend(out);
         Ok(queries.into_inner())
     }
 
@@ -432,7 +430,7 @@ impl Solve<'_> {
         };
         let (scene, vis, options) = (self.scene, self.vis, self.options);
         let threads = options.threads.max(1);
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         let mut queries = 0;
         // The chains of the new samples, and the lights' light they bring.
         let settings = (
@@ -498,10 +496,10 @@ impl Solve<'_> {
         };
         for (k, new) in caustic.iter().enumerate().take(first_new) {
             let change = *new - transfer.caustic.get(k).copied().unwrap_or_default();
-            let rho = reflectance(scene, &solution.samples, k);
-            solution.irradiance[k] += change;
+            let rho = reflectance(scene, &solution.field.samples, k);
+            solution.field.irradiance[k] += change;
             solution.unshot[k] += rho * change;
-            solution.radiosity[k] += rho * change;
+            solution.field.radiosity[k] += rho * change;
         }
         transfer.caustic = caustic;
         solution.specular = Some(transfer);
@@ -512,7 +510,7 @@ impl Solve<'_> {
     /// row scales the new samples start from.
     fn row_scales(&mut self, solution: &mut Solution, round: u32, first_new: usize) -> Result<()> {
         let scene = self.scene;
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         let sides = reflecting_sides(scene);
         let mut reflecting = vec![false; 2 * scene.surfaces.len()];
         for &side in &sides {
@@ -525,7 +523,7 @@ impl Solve<'_> {
             normalise::closed_hemispheres(
                 scene,
                 &reflecting,
-                &solution.samples,
+                &solution.field.samples,
                 first_new,
                 self.vis,
                 (self.options.seed, self.options.threads.max(1)),
@@ -554,16 +552,26 @@ impl Solve<'_> {
             // of their nearest old sample. The hierarchy sums every round's rows.
             // A neighbour covered as it is: a row scale corrects the discretisation, which
             // differs under a cover and beside it.
-            let s = &solution.samples;
+            let s = &solution.field.samples;
             let scale = if round == 0 || hierarchical {
                 1.0
             } else {
-                let covered = &solution.covered;
+                let covered = solution.field.layout.covered();
                 let old = |j: u32| (j as usize) < first_new;
                 let alike = |j: u32| old(j) && covered[j as usize] == covered[k];
-                (solution.index.nearest_where(s, s.side[k], s.uv[k], alike))
-                    .or_else(|| solution.index.nearest_where(s, s.side[k], s.uv[k], old))
-                    .map_or(1.0, |j| solution.row_scale[j as usize])
+                (solution
+                    .field
+                    .layout
+                    .index()
+                    .nearest_where(s, s.side[k], s.uv[k], alike))
+                .or_else(|| {
+                    solution
+                        .field
+                        .layout
+                        .index()
+                        .nearest_where(s, s.side[k], s.uv[k], old)
+                })
+                .map_or(1.0, |j| solution.row_scale[j as usize])
             };
             solution.row_scale.push(scale);
         }
@@ -593,7 +601,7 @@ impl Solve<'_> {
         solution_bytes: usize,
     ) -> Result<(ShootStats, Option<f64>)> {
         let (scene, vis, options) = (self.scene, self.vis, self.options);
-        let n = solution.samples.len();
+        let n = solution.field.samples.len();
         if self.reporter.stopped() {
             let mut stats = ShootStats::new();
             stats.stop = StopReason::Stopped;
@@ -601,15 +609,20 @@ impl Solve<'_> {
         }
         let hierarchical = self.grid.is_some();
         let reflectances: Vec<DVec3> = (0..n)
-            .map(|k| reflectance(scene, &solution.samples, k))
+            .map(|k| reflectance(scene, &solution.field.samples, k))
             .collect();
-        let dark_emitters: Vec<f64> = solution.direct.iter().map(|a| a.dark_emitters).collect();
+        let dark_emitters: Vec<f64> = solution
+            .field
+            .direct
+            .iter()
+            .map(|a| a.dark_emitters)
+            .collect();
         let mut state = State {
-            samples: &solution.samples,
-            maps: &solution.maps,
+            samples: &solution.field.samples,
+            maps: solution.field.layout.maps(),
             reflectance: &reflectances,
-            radiosity: &solution.radiosity,
-            irradiance: &mut solution.irradiance,
+            radiosity: &solution.field.radiosity,
+            irradiance: &mut solution.field.irradiance,
             unshot: &mut solution.unshot,
             ledger: &mut solution.ledger,
             row_scale: &mut solution.row_scale,
@@ -664,7 +677,7 @@ impl Solve<'_> {
                     scene,
                     grid,
                     samples: state.samples,
-                    obstruction: &solution.obstruction,
+                    obstruction: solution.field.layout.obstruction(),
                     lift: self.lift,
                 };
                 cluster::shoot(&mut state, vis, &settings, &cx, &mut report)?
@@ -681,20 +694,20 @@ impl Solve<'_> {
         round: u32,
     ) -> Result<Option<AddedSamples>> {
         let t = Instant::now();
-        if self.begin(Phase::Adaptive, round, solution.samples.len()) {
+        if self.begin(Phase::Adaptive, round, solution.field.samples.len()) {
             return Ok(None);
         }
         let options = self.options;
-        let n = solution.samples.len();
-        let radii = solution.samples.radius.clone();
+        let n = solution.field.samples.len();
+        let radii = solution.field.samples.radius.clone();
         let base = self.base(Phase::Adaptive, round, n);
         let refinement = adaptive::refine(
-            &mut solution.samples,
-            &solution.maps,
-            &solution.index,
-            &solution.obstruction,
+            &mut solution.field.samples,
+            solution.field.layout.maps(),
+            solution.field.layout.index(),
+            solution.field.layout.obstruction(),
             self.vis,
-            &solution.radiosity,
+            &solution.field.radiosity,
             RefineSettings {
                 epsilon: self.epsilon,
                 zeta: options.zeta,
@@ -713,9 +726,9 @@ impl Solve<'_> {
         // A Stop heard while the errors were measured added nothing; one heard at their last
         // report may have, and the round that follows then keeps the arrays whole (its
         // phases are skipped).
-        solution.samples.shrink_to_fit();
-        let samples = &solution.samples;
-        let mut changed = vec![false; 2 * solution.maps.len()];
+        solution.field.samples.shrink_to_fit();
+        let samples = &solution.field.samples;
+        let mut changed = vec![false; 2 * solution.field.layout.maps().len()];
         for k in 0..samples.len() {
             if radii.get(k) != Some(&samples.radius[k]) {
                 changed[samples.side[k] as usize] = true;

@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3};
 
 use super::Solution;
 use crate::error::Result;
-use crate::render::interpolate::{Interpolator, Site};
+use crate::field::interpolate::{Interpolator, Site};
 use crate::scene::Scene;
 use crate::specular::gather::{Chains, End};
 use crate::specular::highlight::Highlights;
@@ -63,9 +63,9 @@ impl Transfer {
         (depth, rays, seed, threads): (u32, u32, u64, usize),
         first: usize,
     ) -> Result<u64> {
-        let s = &solution.samples;
+        let s = &solution.field.samples;
         let n = s.len();
-        let interpolator = Interpolator::new(scene, solution, vis);
+        let interpolator = Interpolator::new(scene, &solution.field, vis);
         let has_samples = |side| interpolator.has_samples(side);
         let highlights = Highlights::of(scene, spec);
         let chains = Chains {
@@ -145,7 +145,7 @@ impl Transfer {
     /// power is over its area. So a sample's irradiance is the photons' average over the very
     /// region its area stands for, and a uniform irradiance comes out uniform.
     pub(crate) fn deposit(&self, solution: &Solution) -> Vec<DVec3> {
-        let s = &solution.samples;
+        let s = &solution.field.samples;
         let mut cell_power = vec![DVec3::ZERO; s.cells.len()];
         let mut loose = vec![DVec3::ZERO; s.len()];
         // The landings side by side, each side's cells found by their grid keys.
@@ -156,7 +156,8 @@ impl Transfer {
         let mut grid = None;
         for i in order {
             let landing = &self.landings[i];
-            let map = &solution.maps[crate::sampling::surface_of(landing.side) as usize];
+            let map =
+                &solution.field.layout.maps()[crate::sampling::surface_of(landing.side) as usize];
             if landing.side != side {
                 side = landing.side;
                 let cell = 2.0 * s.cell_half.get(side as usize).copied().unwrap_or(0.0);
@@ -189,7 +190,7 @@ impl Transfer {
                 Some(c) => cell_power[c as usize] += power,
                 // Off every cell (at a rim, by rounding): to the nearest sample.
                 None => {
-                    if let Some(k) = solution.index.nearest(s, landing.side, uv) {
+                    if let Some(k) = solution.field.layout.index().nearest(s, landing.side, uv) {
                         loose[k as usize] += power;
                     }
                 }
@@ -220,16 +221,16 @@ impl Transfer {
         solution: &Solution,
         vis: &dyn Visibility,
     ) -> Result<u64> {
-        let s = &solution.samples;
+        let s = &solution.field.samples;
         let n = s.len();
-        let interpolator = Interpolator::new(scene, solution, vis).plain();
+        let interpolator = Interpolator::new(scene, &solution.field, vis).plain();
         let points: Vec<(Vec3, Vec3)> = self.ends.iter().map(|e| (e.point, e.normal)).collect();
         let covered = interpolator.covered(&points)?;
         let sites: Vec<Site> = self
             .ends
             .iter()
             .zip(&covered)
-            .map(|(e, &covered)| e.site(covered))
+            .map(|(e, &covered)| Site::at(e.point, e.side, e.normal, covered))
             .collect();
         let mut weights = Vec::new();
         let queries = interpolator.weights(&sites, &mut weights)? + covered.len() as u64;
@@ -349,7 +350,7 @@ mod tests {
             ..Options::default()
         };
         let s = solve(&scene, vis.as_ref(), &options, &mut |_| Control::Continue).unwrap();
-        let samples = &s.samples;
+        let samples = &s.field.samples;
         assert!(samples.round.contains(&1), "adaptive samples too");
         // The floor: the largest side facing up.
         let side = (0..2 * scene.surfaces.len() as u32)
@@ -364,7 +365,7 @@ mod tests {
                 area(a).total_cmp(&area(b))
             })
             .unwrap();
-        let map = &s.maps[crate::sampling::surface_of(side) as usize];
+        let map = &s.field.layout.maps()[crate::sampling::surface_of(side) as usize];
         let cell = 2.0 * samples.cell_half[side as usize];
         let (nx, ny) = (
             ((map.max.x - map.min.x) / cell).ceil() as usize * 4,

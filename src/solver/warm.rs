@@ -37,7 +37,7 @@ pub(crate) fn emission(scene: &Scene, samples: &Samples, k: usize) -> DVec3 {
 /// specular surfaces (by glossy bounces, through chains of images, the photons') and the
 /// daylight entering (0 without either).
 pub(crate) fn exact_beyond_direct(solution: &Solution, k: usize) -> DVec3 {
-    let daylight = solution.daylight.get(k).copied().unwrap_or_default();
+    let daylight = solution.field.daylight.get(k).copied().unwrap_or_default();
     daylight
         + solution.specular.as_ref().map_or(DVec3::ZERO, |t| {
             [&t.direct, &t.far, &t.caustic]
@@ -61,12 +61,12 @@ pub(crate) fn start(
     alpha: f32,
     (threads, ranks): (usize, &dyn crate::distributed::Ranks),
 ) -> Result<()> {
-    let n = solution.samples.len();
+    let n = solution.field.samples.len();
     // (irradiance, unshot, radiosity) of each new sample.
     let mut out = vec![(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); n - first_new];
     let shared: &Solution = solution;
     let each = |first: usize, chunk: &mut [(DVec3, DVec3, DVec3)]| {
-        let samples = &shared.samples;
+        let samples = &shared.field.samples;
         let mut near = Vec::new();
         let r = 2.0 * epsilon;
         for (o, k) in chunk.iter_mut().zip(first_new + first..) {
@@ -74,21 +74,25 @@ pub(crate) fn start(
             // Interpolated from the old samples: indirect irradiance, and radiosity already shot.
             let (mut wsum, mut indirect, mut shot) = (0.0, DVec3::ZERO, DVec3::ZERO);
             if first_new > 0 {
-                shared
-                    .index
-                    .within(samples, samples.side[k], samples.uv[k], r, &mut near);
+                shared.field.layout.index().within(
+                    samples,
+                    samples.side[k],
+                    samples.uv[k],
+                    r,
+                    &mut near,
+                );
                 near.retain(|&(j, _)| (j as usize) < first_new);
                 near.sort_unstable_by_key(|&(j, _)| j);
-                shared.obstruction.retain_visible(
+                shared.field.layout.obstruction().retain_visible(
                     vis,
-                    &shared.maps,
+                    shared.field.layout.maps(),
                     samples,
                     samples.side[k],
                     samples.position[k],
                     &mut near,
                 )?;
                 // Neighbours covered as this sample is, if there are any (`sampling::cover`).
-                let covered = &shared.covered;
+                let covered = shared.field.layout.covered();
                 if near.iter().any(|&(j, _)| covered[j as usize] == covered[k]) {
                     near.retain(|&(j, _)| covered[j as usize] == covered[k]);
                 }
@@ -98,9 +102,9 @@ pub(crate) fn start(
                     wsum += w;
                     // What is exact at the new sample (its direct light, and the lights' light
                     // by way of glossy bounces) is not interpolated.
-                    let exact = shared.direct[j].irradiance + exact_beyond_direct(shared, j);
-                    indirect += w * (shared.irradiance[j] - exact);
-                    shot += w * (rho * shared.irradiance[j] - shared.unshot[j]);
+                    let exact = shared.field.direct[j].irradiance + exact_beyond_direct(shared, j);
+                    indirect += w * (shared.field.irradiance[j] - exact);
+                    shot += w * (rho * shared.field.irradiance[j] - shared.unshot[j]);
                 }
             }
             if wsum > 0.0 {
@@ -130,16 +134,16 @@ pub(crate) fn start(
         },
     )?;
     // Exactly: a round's new samples would leave up to as many slots unused.
-    solution.direct.reserve_exact(arrivals.len());
-    solution.irradiance.reserve_exact(out.len());
+    solution.field.direct.reserve_exact(arrivals.len());
+    solution.field.irradiance.reserve_exact(out.len());
     solution.unshot.reserve_exact(out.len());
-    solution.radiosity.reserve_exact(out.len());
-    solution.direct.extend_from_slice(arrivals);
+    solution.field.radiosity.reserve_exact(out.len());
+    solution.field.direct.extend_from_slice(arrivals);
     for (h, unshot, radiosity) in out {
-        solution.irradiance.push(h);
+        solution.field.irradiance.push(h);
         solution.unshot.push(unshot);
-        solution.radiosity.push(radiosity);
+        solution.field.radiosity.push(radiosity);
     }
-    debug_assert_eq!(solution.irradiance.len(), n);
+    debug_assert_eq!(solution.field.irradiance.len(), n);
     Ok(())
 }

@@ -55,18 +55,6 @@ pub(crate) struct End {
     pub weight: DVec3,
 }
 
-impl End {
-    /// Where interpolation reads the end's surface.
-    pub(crate) fn site(&self, covered: bool) -> crate::render::interpolate::Site {
-        crate::render::interpolate::Site {
-            point: self.point,
-            side: self.side,
-            normal: self.normal,
-            covered,
-        }
-    }
-}
-
 /// What the chains of a batch of receivers found.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Found {

@@ -40,7 +40,7 @@ impl Lights {
         let mut areas = Vec::new();
         for group in scene.emitter_groups() {
             let triangles = scene.triangles_of(&group);
-            let cumulative = crate::light::cumulative_area(&triangles);
+            let cumulative = crate::sampling::triangles::cumulative_area(&triangles);
             let total = cumulative.last().copied().unwrap_or(0.0);
             for &s in &group {
                 of_surface[s as usize] = Some(areas.len() as u32);
@@ -228,7 +228,7 @@ impl AreaLight {
         let start = if t == 0 { 0.0 } else { self.cumulative[t - 1] };
         let within = ((u - start) / (self.cumulative[t] - start)).clamp(0.0, 1.0);
         (
-            crate::light::in_triangle(self.triangles[t], within, u2),
+            crate::sampling::triangles::in_triangle(self.triangles[t], within, u2),
             self.normals[t],
         )
     }

@@ -5,7 +5,6 @@ mod bvh;
 mod checked;
 #[cfg(feature = "embree")]
 mod embree;
-pub mod workload;
 
 use std::fmt;
 use std::str::FromStr;

@@ -1,13 +1,14 @@
-//! Query sets shaped like the solver's and the renderer's, for benchmarks and backend
-//! cross-checks: segments between random points of facing surface sides, and camera rays.
-//! Deterministic from a seed.
+//! Query sets shaped like the solver's and the renderer's, for `bench-vis`, the criterion
+//! benchmark and the backends' cross-check (which include this file): segments between random
+//! points of facing surface sides, and camera rays. Deterministic from a seed; written against
+//! the library's public interface only.
 
 use glam::Vec3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::{Ray, Segment};
-use crate::scene::Scene;
+use meshlight::visibility::{Ray, Segment};
+use meshlight::Scene;
 
 /// A point on a reflecting surface side.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,8 +36,8 @@ impl<'a> SurfacePointSampler<'a> {
         let mut sides = Vec::new();
         let mut cumulative = Vec::new();
         let mut total = 0.0;
-        for (i, t) in scene.triangles.iter().enumerate() {
-            let back = scene.surfaces[t.surface as usize].two_sided;
+        for (i, t) in scene.triangles().iter().enumerate() {
+            let back = scene.surfaces()[t.surface as usize].two_sided;
             for side in [false, true].into_iter().take(if back { 2 } else { 1 }) {
                 total += f64::from(t.area);
                 sides.push((i as u32, side));
@@ -62,7 +63,7 @@ impl<'a> SurfacePointSampler<'a> {
             .partition_point(|&c| c <= x)
             .min(self.sides.len() - 1);
         let (t, back) = self.sides[k];
-        let tri = &self.scene.triangles[t as usize];
+        let tri = &self.scene.triangles()[t as usize];
         let (mut u, mut v) = (rng.random::<f32>(), rng.random::<f32>());
         if u + v > 1.0 {
             (u, v) = (1.0 - u, 1.0 - v);
@@ -77,11 +78,11 @@ impl<'a> SurfacePointSampler<'a> {
 }
 
 /// Up to `n` segments between random points of surface sides that face each other, ends lifted
-/// by [`LIFT`](super::LIFT) × diagonal along their normals. Fewer come back only if facing pairs are so rare
+/// by `meshlight::visibility::LIFT` × diagonal along their normals. Fewer come back only if facing pairs are so rare
 /// that 100·n draws do not find them.
 pub fn facing_segments(scene: &Scene, n: usize, seed: u64) -> Vec<Segment> {
     let sampler = SurfacePointSampler::new(scene);
-    let lift = crate::visibility::lift(scene);
+    let lift = meshlight::visibility::lift(scene);
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
     let mut segments = Vec::with_capacity(n);
     for _ in 0..n.saturating_mul(100) {
@@ -103,7 +104,7 @@ pub fn facing_segments(scene: &Scene, n: usize, seed: u64) -> Vec<Segment> {
 
 /// `n` camera rays through random points of random pixels.
 pub fn camera_rays(scene: &Scene, n: usize, seed: u64) -> Vec<Ray> {
-    let camera = &scene.camera;
+    let camera = scene.camera();
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
     (0..n)
         .map(|_| {

@@ -8,10 +8,10 @@
 
 use glam::{DVec2, Vec3};
 
+use super::Field;
 use crate::error::Result;
 use crate::sampling::{cover, is_back, surface_of, Side};
 use crate::scene::Scene;
-use crate::solver::Solution;
 use crate::visibility::{Segment, Visibility};
 
 /// Kernel support: a sample reaches this many of its radii D.
@@ -28,9 +28,21 @@ pub(crate) struct Site {
     pub covered: bool,
 }
 
-/// What interpolation reads of a solution.
+impl Site {
+    /// The site at `point` on `side` (whose normal is `normal`).
+    pub(crate) fn at(point: Vec3, side: Side, normal: Vec3, covered: bool) -> Site {
+        Site {
+            point,
+            side,
+            normal,
+            covered,
+        }
+    }
+}
+
+/// What interpolation reads of a field.
 pub(crate) struct Interpolator<'a> {
-    solution: &'a Solution,
+    field: &'a Field,
     vis: &'a dyn Visibility,
     lift: f32,
     /// Largest kernel support among each side's samples (0: the side has none).
@@ -41,14 +53,14 @@ pub(crate) struct Interpolator<'a> {
 }
 
 impl<'a> Interpolator<'a> {
-    pub(crate) fn new(scene: &'a Scene, solution: &'a Solution, vis: &'a dyn Visibility) -> Self {
-        let s = &solution.samples;
+    pub(crate) fn new(scene: &'a Scene, field: &'a Field, vis: &'a dyn Visibility) -> Self {
+        let s = &field.samples;
         let mut support = vec![0.0f32; 2 * scene.surfaces.len()];
         for (&side, &d) in s.side.iter().zip(&s.radius) {
             support[side as usize] = support[side as usize].max(SUPPORT * d);
         }
         Interpolator {
-            solution,
+            field,
             vis,
             lift: crate::visibility::lift(scene),
             support,
@@ -65,7 +77,7 @@ impl<'a> Interpolator<'a> {
 
     /// The samples interpolated.
     pub(crate) fn samples(&self) -> &crate::sampling::Samples {
-        &self.solution.samples
+        &self.field.samples
     }
 
     /// The sample of the site's side nearest to it (among those covered as it is, if any),
@@ -73,8 +85,8 @@ impl<'a> Interpolator<'a> {
     /// final gather, each a small share of its answer, where kernels and their visibility
     /// queries would cost more than the rest of the render.
     pub(crate) fn nearest(&self, site: &Site) -> Option<u32> {
-        let (s, index) = (&self.solution.samples, &self.solution.index);
-        let uv = self.solution.maps[surface_of(site.side) as usize].to_2d(site.point);
+        let (s, index) = (&self.field.samples, &self.field.layout.index);
+        let uv = self.field.layout.maps[surface_of(site.side) as usize].to_2d(site.point);
         index
             .nearest_where(s, site.side, uv, |k| {
                 self.sample_covered(k as usize) == site.covered
@@ -91,7 +103,7 @@ impl<'a> Interpolator<'a> {
     pub(crate) fn covered(&self, points: &[(Vec3, Vec3)]) -> Result<Vec<bool>> {
         let covers: Vec<Segment> = points
             .iter()
-            .map(|&(p, n)| cover::segment(p, n, self.lift, self.solution.epsilon))
+            .map(|&(p, n)| cover::segment(p, n, self.lift, self.field.layout.epsilon))
             .collect();
         let mut answers = vec![false; covers.len()];
         self.vis.occluded(&covers, &mut answers)?;
@@ -102,22 +114,23 @@ impl<'a> Interpolator<'a> {
     /// sample order; or its nearest visible sample (weight 1); or none when it is sealed off
     /// from them all. Returns the visibility queries.
     pub(crate) fn weights(&self, sites: &[Site], out: &mut Vec<Vec<(u32, f32)>>) -> Result<u64> {
-        let s = &self.solution.samples;
+        let s = &self.field.samples;
         let mut candidates: Vec<(u32, f32)> = Vec::new();
         let mut ranges = Vec::with_capacity(sites.len());
         let mut segments = Vec::new();
         let mut near = Vec::new();
         for site in sites {
-            let map = &self.solution.maps[surface_of(site.side) as usize];
+            let map = &self.field.layout.maps[surface_of(site.side) as usize];
             let from = site.point + self.lift * site.normal;
             let uv = map.to_2d(site.point);
             let reach = self.support[site.side as usize];
-            self.solution
+            self.field
+                .layout
                 .index
                 .within(s, site.side, uv, reach, &mut near);
             near.sort_unstable_by_key(|&(k, _)| k);
             let start = candidates.len();
-            let test = self.solution.obstruction.is_obstructed(site.side);
+            let test = self.field.layout.obstruction.is_obstructed(site.side);
             for &(k, d2) in &near {
                 let r = SUPPORT * s.radius[k as usize];
                 let q = d2 / (r * r);
@@ -162,7 +175,7 @@ impl<'a> Interpolator<'a> {
                 queries += q;
                 chosen.extend(nearest.map(|k| (k, 1.0)));
             } else if self.linear {
-                let map = &self.solution.maps[surface_of(site.side) as usize];
+                let map = &self.field.layout.maps[surface_of(site.side) as usize];
                 let at = map.to_2d(site.point);
                 // Each value is its region's average, which a linear field takes at the
                 // region's centroid: the fit places the values there.
@@ -183,15 +196,15 @@ impl<'a> Interpolator<'a> {
 
     /// Whether sample k is covered (`sampling::cover`); a solution without the flags has none.
     fn sample_covered(&self, k: usize) -> bool {
-        self.solution.covered.get(k).copied().unwrap_or(false)
+        self.field.layout.covered.get(k).copied().unwrap_or(false)
     }
 
     /// Fallback where no sample's kernel reaches a visible point: the nearest visible sample of
     /// the side within a growing radius, if any.
     fn nearest_visible(&self, side: Side, point: Vec3) -> Result<(Option<u32>, u64)> {
-        let s = &self.solution.samples;
+        let s = &self.field.samples;
         let surface = surface_of(side);
-        let map = &self.solution.maps[surface as usize];
+        let map = &self.field.layout.maps[surface as usize];
         let normal = if is_back(side) {
             -map.normal
         } else {
@@ -204,7 +217,7 @@ impl<'a> Interpolator<'a> {
         let mut r = self.support[side as usize];
         for _ in 0..4 {
             r *= 2.0;
-            self.solution.index.within(s, side, uv, r, &mut near);
+            self.field.layout.index.within(s, side, uv, r, &mut near);
             near.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
             near.truncate(16);
             let segments: Vec<Segment> = near
