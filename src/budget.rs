@@ -52,6 +52,31 @@ impl Breakdown {
     }
 }
 
+/// A size in bytes from its text: a number with an optional K, M or G suffix (binary units).
+pub(crate) fn parse_bytes(text: &str) -> Result<usize, String> {
+    let t = text.trim();
+    let (number, unit) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => (&t[..i], c.to_ascii_uppercase()),
+        _ => (t, 'B'),
+    };
+    let scale: f64 = match unit {
+        'B' => 1.0,
+        'K' => 1024.0,
+        'M' => 1024.0 * 1024.0,
+        'G' => 1024.0 * 1024.0 * 1024.0,
+        _ => return Err(format!("'{text}': the unit must be K, M or G")),
+    };
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a size (e.g. 512M, 8G)"))?;
+    let bytes = value * scale;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < usize::MAX as f64) {
+        return Err(format!("'{text}' is not a positive size"));
+    }
+    Ok(bytes as usize)
+}
+
 /// Bytes in binary units, for messages: "3.2 GiB".
 pub(crate) fn human_bytes(bytes: f64) -> String {
     const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
@@ -170,6 +195,18 @@ pub(crate) fn exceeded(budget: usize, problem: String) -> crate::Error {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn sizes_parse_in_binary_units() {
+        use super::parse_bytes;
+        assert_eq!(parse_bytes("1000"), Ok(1000));
+        assert_eq!(parse_bytes("512M"), Ok(512 << 20));
+        assert_eq!(parse_bytes("8g"), Ok(8 << 30));
+        assert_eq!(parse_bytes("1.5K"), Ok(1536));
+        for bad in ["", "G", "-1G", "0", "4X", "lots"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -55,6 +55,7 @@ pub mod daylight;
 pub mod diagnose;
 pub mod distributed;
 pub mod error;
+mod exec;
 pub mod field;
 pub mod ies;
 mod light;

@@ -42,68 +42,104 @@ pub struct SolveArgs {
     pub knobs: Knobs,
 }
 
-/// Every solver setting but the scene and ε.
-#[derive(clap::Args, Clone)]
+/// Every solver setting but the scene and ε: the preset, the backend, and the library's knob
+/// table ([`meshlight::solver::KNOBS`]) as flags, one per knob, as the table names and
+/// describes it (ε is [`SolveArgs`]' own, since `scale` takes a list of them).
+#[derive(Clone, Debug)]
 pub struct Knobs {
     /// Start from a preset: preview, default or final.
-    #[arg(long, default_value = "default")]
     pub preset: String,
-    /// Multiplies the ε from the scene file or the automatic choice (not `--epsilon`), 1/16 to
-    /// 16 [default: the preset's: 1, final 0.6].
-    #[arg(long)]
-    pub epsilon_scale: Option<f32>,
-    /// Adaptive error threshold ζ, relative to the mean radiosity.
-    #[arg(long)]
-    pub zeta: Option<f32>,
-    /// Area weight fall-off α (eq. 5).
-    #[arg(long)]
-    pub alpha: Option<f32>,
-    /// Adaptive rounds after the first solve.
-    #[arg(long)]
-    pub rounds: Option<u32>,
-    /// Shadow rays per area light and sample.
-    #[arg(long)]
-    pub light_samples: Option<u32>,
-    /// Stop shooting when unshot power < this fraction of emitted power.
-    #[arg(long)]
-    pub tolerance: Option<f64>,
-    /// At most this many shots per solve.
-    #[arg(long)]
-    pub max_shots: Option<u64>,
-    /// Refuse to place more samples than this.
-    #[arg(long)]
-    pub max_samples: Option<usize>,
-    /// The memory budget every large structure counts against: bytes, or with a K, M or G
-    /// suffix (binary units), e.g. 512M, 8G (default 8G).
-    #[arg(long, value_parser = parse_bytes)]
-    pub memory_budget: Option<usize>,
-    /// Cluster hierarchy error threshold, relative to the mean radiosity (0: the flat solver).
-    #[arg(long)]
-    pub cluster_threshold: Option<f64>,
-    /// Refine every partly visible cluster link down to samples, however faint (slower).
-    #[arg(long)]
-    pub exact_visibility: bool,
-    /// Specular bounces light may take between diffuse surfaces (mirror images of lights, and
-    /// chains through mirrors, glossy surfaces and glass); 0 makes specular surfaces black.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::solver::MAX_SPECULAR_DEPTH)))]
-    pub specular_depth: Option<u32>,
-    /// Chains followed from each sample through specular surfaces (more: less noise in the
-    /// light that arrives by way of mirrors, glossy surfaces and glass).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::solver::MAX_SPECULAR_RAYS)))]
-    pub specular_rays: Option<u32>,
-    /// Photons sent from the lights through curved mirrors and refracting solids (more: less
-    /// noise in the light they focus onto surfaces, the caustics).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=meshlight::solver::MAX_PHOTONS))]
-    pub photons: Option<u64>,
     /// Visibility backend: embree or bvh.
-    #[arg(long)]
     pub backend: Option<Backend>,
-    /// Worker threads.
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// Seed of all random choices.
-    #[arg(long)]
-    pub seed: Option<u64>,
+    /// The knobs given, by the table's name, as typed (switches as `true`).
+    pub given: Vec<(&'static str, String)>,
+}
+
+/// The knobs that are flags of [`Knobs`].
+fn knob_flags() -> impl Iterator<Item = &'static meshlight::solver::Knob> {
+    meshlight::solver::KNOBS
+        .iter()
+        .filter(|k| k.name != "epsilon")
+}
+
+/// A knob's value as the command line gives it, checked by the table.
+fn knob_value(
+    knob: &'static meshlight::solver::Knob,
+) -> impl Fn(&str) -> Result<String, String> + Clone {
+    move |text: &str| {
+        knob.set(&mut Options::default(), text)
+            .map(|()| text.to_string())
+            .map_err(|e| match e {
+                meshlight::Error::Option { problem, .. } => problem,
+                other => other.to_string(),
+            })
+    }
+}
+
+impl clap::Args for Knobs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        let cmd = cmd
+            .arg(
+                clap::Arg::new("preset")
+                    .long("preset")
+                    .value_name("PRESET")
+                    .default_value("default")
+                    .help("Start from a preset: preview, default or final"),
+            )
+            .arg(
+                clap::Arg::new("backend")
+                    .long("backend")
+                    .value_name("BACKEND")
+                    .value_parser(clap::value_parser!(Backend))
+                    .help("Visibility backend: embree or bvh"),
+            );
+        knob_flags().fold(cmd, |cmd, k| {
+            let arg = clap::Arg::new(k.name)
+                .long(k.name.replace('_', "-"))
+                .help(k.help);
+            cmd.arg(match k.value {
+                Some(name) => arg.value_name(name).value_parser(knob_value(k)),
+                None => arg.action(clap::ArgAction::SetTrue),
+            })
+        })
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+impl clap::FromArgMatches for Knobs {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut given = Vec::new();
+        for k in knob_flags() {
+            match k.value {
+                Some(_) => {
+                    if let Some(text) = m.get_one::<String>(k.name) {
+                        given.push((k.name, text.clone()));
+                    }
+                }
+                None => {
+                    if m.get_flag(k.name) {
+                        given.push((k.name, "true".to_string()));
+                    }
+                }
+            }
+        }
+        Ok(Knobs {
+            preset: m
+                .get_one::<String>("preset")
+                .cloned()
+                .unwrap_or_else(|| "default".into()),
+            backend: m.get_one::<Backend>("backend").copied(),
+            given,
+        })
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
 }
 
 /// What `render --false-color` shows.
@@ -145,23 +181,12 @@ pub enum Method {
     Patches,
 }
 
-/// `render`'s arguments.
-#[derive(clap::Args)]
-pub struct RenderArgs {
-    #[command(flatten)]
-    pub solve: SolveArgs,
-    /// Output image (.exr); the PNG gets the same name with .png.
-    #[arg(short, long, default_value = "out.exr")]
-    pub output: PathBuf,
-    /// Image width in pixels, instead of the scene's (a .glb carries none); with only one of
-    /// --width and --height, the other keeps the camera's aspect ratio.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub width: Option<u32>,
-    /// Image height in pixels, instead of the scene's.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub height: Option<u32>,
-    /// Rays per side on pixels that straddle an edge (1 = one ray per pixel) [default: the
-    /// preset's: preview 2, default 4, final 8].
+/// How an image is made from a solution (or by the references): the flags `render` and
+/// `sweep` share; `sweep --vary` takes the same names.
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct RenderFlags {
+    /// Rays per side on pixels that straddle an edge (1 = one ray per pixel; patches: per
+    /// pixel) [default: the preset's: preview 2, default 4, final 8].
     #[arg(long)]
     pub supersample: Option<u32>,
     /// Meshless: shadow rays per area light traced at each camera hit for its direct light
@@ -181,19 +206,51 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 16,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(meshlight::render::MAX_GLOSSY_RAYS)))]
     pub glossy_rays: u32,
+    /// Path tracing: samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Patches: the side of the square patches (default: the solver's ε).
+    #[arg(long)]
+    pub patch_size: Option<f32>,
+}
+
+/// The keys `sweep --vary` takes beyond the solver's knobs (`meshlight::solver::KNOBS`): the
+/// preset, the backend and [`RenderFlags`], as the command line spells them.
+pub const RENDER_KEYS: [&str; 8] = [
+    "preset",
+    "backend",
+    "supersample",
+    "direct-rays",
+    "gather-rays",
+    "glossy-rays",
+    "spp",
+    "patch-size",
+];
+
+/// `render`'s arguments.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Output image (.exr); the PNG gets the same name with .png.
+    #[arg(short, long, default_value = "out.exr")]
+    pub output: PathBuf,
+    /// Image width in pixels, instead of the scene's (a .glb carries none); with only one of
+    /// --width and --height, the other keeps the camera's aspect ratio.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub width: Option<u32>,
+    /// Image height in pixels, instead of the scene's.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub height: Option<u32>,
+    #[command(flatten)]
+    pub render: RenderFlags,
     /// How to compute the image: meshless (the solver), or pathtrace (the independent
     /// reference: unbiased Monte Carlo path tracing).
     #[arg(long, default_value = "meshless")]
     pub method: Method,
-    /// Path tracing: samples per pixel.
-    #[arg(long, default_value_t = 64)]
-    pub spp: u32,
     /// Path tracing: stop after this many seconds (with fewer samples per pixel).
     #[arg(long)]
     pub time: Option<f64>,
-    /// Patches: the side of the square patches (default: the solver's ε).
-    #[arg(long)]
-    pub patch_size: Option<f32>,
     /// Write the PNG as a false-colour picture with a legend in the scene's unit instead of
     /// a tone-mapped one: the luminance seen, or the illuminance on the surface seen (then
     /// the EXR holds the illuminance too).
@@ -218,34 +275,16 @@ pub struct SweepArgs {
     #[arg(long)]
     pub reference: PathBuf,
     /// A setting and its values, KEY=V1,V2,...; repeat for a grid of every combination.
-    /// Keys: preset, epsilon, epsilon-scale, zeta, alpha, rounds, light-samples, tolerance, max-shots,
-    /// max-samples, cluster-threshold, exact-visibility, backend, threads, seed,
-    /// supersample, direct-rays, gather-rays, specular-depth, specular-rays, photons, glossy-rays, patch-size, spp.
+    /// Keys: every solver flag (epsilon, epsilon-scale, zeta, alpha, rounds, light-samples, …),
+    /// preset, backend and the render flags (supersample, direct-rays, gather-rays, glossy-rays,
+    /// spp, patch-size); an unknown key's error lists them all.
     #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
     pub vary: Vec<(String, Vec<String>)>,
     /// How each run computes its image.
     #[arg(long, default_value = "meshless")]
     pub method: Method,
-    /// Rays per side on edge pixels (meshless) or per pixel (patches) [default: the
-    /// preset's].
-    #[arg(long)]
-    pub supersample: Option<u32>,
-    /// Meshless: shadow rays per area light traced at each camera hit for its direct light;
-    /// 0 interpolates it from the samples [default: the preset's].
-    #[arg(long,
-          value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::MAX_LIGHT_SAMPLES)))]
-    pub direct_rays: Option<u32>,
-    /// Meshless: rays gathered at a camera hit near another surface; 0 interpolates there too
-    /// [default: the preset's].
-    #[arg(long,
-          value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::render::MAX_GATHER_RAYS)))]
-    pub gather_rays: Option<u32>,
-    /// Patches: the side of the square patches (default: the solver's ε).
-    #[arg(long)]
-    pub patch_size: Option<f32>,
-    /// Path tracing runs: samples per pixel.
-    #[arg(long, default_value_t = 64)]
-    pub spp: u32,
+    #[command(flatten)]
+    pub render: RenderFlags,
     /// Output prefix: writes PREFIX.csv and PREFIX.png.
     #[arg(long, default_value = "sweep")]
     pub out: PathBuf,
@@ -430,52 +469,28 @@ pub fn bvh_presets(names: &[String]) -> anyhow::Result<Vec<BvhPreset>> {
     Ok(presets)
 }
 
-/// A size in bytes: a number with an optional K, M or G suffix (binary units).
-pub fn parse_bytes(text: &str) -> Result<usize, String> {
-    let t = text.trim();
-    let (number, unit) = match t.char_indices().last() {
-        Some((i, c)) if c.is_ascii_alphabetic() => (&t[..i], c.to_ascii_uppercase()),
-        _ => (t, 'B'),
-    };
-    let scale: f64 = match unit {
-        'B' => 1.0,
-        'K' => 1024.0,
-        'M' => 1024.0 * 1024.0,
-        'G' => 1024.0 * 1024.0 * 1024.0,
-        _ => return Err(format!("'{text}': the unit must be K, M or G")),
-    };
-    let value: f64 = number
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{text}' is not a size (e.g. 512M, 8G)"))?;
-    let bytes = value * scale;
-    if !(bytes.is_finite() && bytes >= 1.0 && bytes < usize::MAX as f64) {
-        return Err(format!("'{text}' is not a positive size"));
-    }
-    Ok(bytes as usize)
-}
-
 /// The visibility backend the command line asks for (default: Embree if built in).
 pub fn backend_from(args: &Knobs) -> meshlight::Backend {
     args.backend
         .unwrap_or_else(meshlight::Backend::default_backend)
 }
 
-/// The render's settings from a preset and the command line: `supersample`, `direct_rays` and
-/// `gather_rays` where given, the preset's otherwise.
+/// The render's settings from a preset and the command line: its flags where given, the
+/// preset's otherwise.
 pub fn render_options_from(
     args: &Knobs,
-    supersample: Option<u32>,
-    direct_rays: Option<u32>,
-    gather_rays: Option<u32>,
+    flags: &RenderFlags,
 ) -> anyhow::Result<meshlight::RenderOptions> {
     let mut o = args
         .preset
         .parse::<meshlight::solver::Preset>()?
         .render_options();
-    o.supersample = supersample.unwrap_or(o.supersample).max(1);
-    o.direct = direct_rays.map_or(o.direct, meshlight::Direct::from_rays);
-    o.gather_rays = gather_rays.unwrap_or(o.gather_rays);
+    o.supersample = flags.supersample.unwrap_or(o.supersample).max(1);
+    o.direct = flags
+        .direct_rays
+        .map_or(o.direct, meshlight::Direct::from_rays);
+    o.gather_rays = flags.gather_rays.unwrap_or(o.gather_rays);
+    o.glossy_rays = flags.glossy_rays;
     Ok(o)
 }
 
@@ -483,37 +498,64 @@ pub fn render_options_from(
 pub fn options_from(epsilon: Option<f32>, args: &Knobs) -> anyhow::Result<Options> {
     let mut o = args.preset.parse::<meshlight::solver::Preset>()?.options();
     o.epsilon = epsilon.or(o.epsilon);
-    o.epsilon_scale = args.epsilon_scale.unwrap_or(o.epsilon_scale);
-    o.zeta = args.zeta.unwrap_or(o.zeta);
-    o.alpha = args.alpha.unwrap_or(o.alpha);
-    o.rounds = args.rounds.unwrap_or(o.rounds);
-    o.light_samples = args.light_samples.unwrap_or(o.light_samples);
-    o.tolerance = args.tolerance.unwrap_or(o.tolerance);
-    o.max_shots = args.max_shots.or(o.max_shots);
-    o.max_samples = args.max_samples.unwrap_or(o.max_samples);
-    o.memory_budget = args.memory_budget.unwrap_or(o.memory_budget);
-    o.cluster_threshold = args.cluster_threshold.unwrap_or(o.cluster_threshold);
-    o.exact_visibility |= args.exact_visibility;
-    o.specular_depth = args.specular_depth.unwrap_or(o.specular_depth);
-    o.specular_rays = args.specular_rays.unwrap_or(o.specular_rays);
-    o.photons = args.photons.unwrap_or(o.photons);
-    o.threads = args.threads.unwrap_or(o.threads).max(1);
-    o.seed = args.seed.unwrap_or(o.seed);
+    for (name, text) in &args.given {
+        o.set(name, text)?;
+    }
     Ok(o)
 }
 
 #[cfg(test)]
 mod tests {
-    use super::parse_bytes;
+    use super::*;
+
+    fn parse(args: &[&str]) -> Result<Args, clap::Error> {
+        Args::try_parse_from(["meshlight", "render", "scene.toml"].iter().chain(args))
+    }
+
+    fn knobs_of(args: &Args) -> (&Option<f32>, &Knobs) {
+        match &args.command {
+            Command::Render(r) => (&r.solve.epsilon, &r.solve.knobs),
+            _ => unreachable!(),
+        }
+    }
 
     #[test]
-    fn sizes_parse_in_binary_units() {
-        assert_eq!(parse_bytes("1000"), Ok(1000));
-        assert_eq!(parse_bytes("512M"), Ok(512 << 20));
-        assert_eq!(parse_bytes("8g"), Ok(8 << 30));
-        assert_eq!(parse_bytes("1.5K"), Ok(1536));
-        for bad in ["", "G", "-1G", "0", "4X", "lots"] {
-            assert!(parse_bytes(bad).is_err(), "{bad}");
-        }
+    fn the_knob_flags_set_what_the_library_table_sets() {
+        let args = parse(&[
+            "--preset",
+            "final",
+            "--light-samples",
+            "7",
+            "--exact-visibility",
+            "--memory-budget",
+            "3M",
+            "--epsilon",
+            "0.5",
+        ])
+        .unwrap();
+        let (epsilon, knobs) = knobs_of(&args);
+        let o = options_from(*epsilon, knobs).unwrap();
+        let mut expected = Options::final_quality();
+        expected.light_samples = 7;
+        expected.exact_visibility = true;
+        expected.memory_budget = 3 << 20;
+        expected.epsilon = Some(0.5);
+        assert_eq!(o, expected);
+        // No flag given: the preset's options as they are.
+        let args = parse(&[]).unwrap();
+        let (epsilon, knobs) = knobs_of(&args);
+        assert_eq!(options_from(*epsilon, knobs).unwrap(), Options::default());
+    }
+
+    #[test]
+    fn a_knob_out_of_range_is_refused_when_parsed_with_its_range() {
+        let e = parse(&["--light-samples", "0"]).err().unwrap().to_string();
+        assert!(e.contains("--light-samples"), "{e}");
+        assert!(
+            e.contains(&format!("must lie in 1..={}", meshlight::MAX_LIGHT_SAMPLES)),
+            "{e}"
+        );
+        let e = parse(&["--threads", "many"]).err().unwrap().to_string();
+        assert!(e.contains("'many' is not a valid value"), "{e}");
     }
 }

@@ -17,35 +17,18 @@ pub fn explain(e: &anyhow::Error) -> String {
     }
 }
 
-/// The command-line flag of a library option, where there is one.
+/// The command-line flag of a library option, where there is one: the flag spelt as the option
+/// with hyphens, looked up in the command's own definition (the solver's flags are made from
+/// its knob table, so every knob has one).
 fn flag(option: &str) -> Option<String> {
-    const FLAGS: [(&str, &str); 21] = [
-        ("gather_rays", "--gather-rays"),
-        ("specular_rays", "--specular-rays"),
-        ("photons", "--photons"),
-        ("specular_depth", "--specular-depth"),
-        ("glossy_rays", "--glossy-rays"),
-        ("epsilon", "--epsilon"),
-        ("alpha", "--alpha"),
-        ("zeta", "--zeta"),
-        ("rounds", "--rounds"),
-        ("light_samples", "--light-samples"),
-        ("tolerance", "--tolerance"),
-        ("max_shots", "--max-shots"),
-        ("max_samples", "--max-samples"),
-        ("cluster_threshold", "--cluster-threshold"),
-        ("memory_budget", "--memory-budget"),
-        ("max_reflectance", "--max-reflectance"),
-        ("patch_size", "--patch-size"),
-        ("supersample", "--supersample"),
-        ("spp", "--spp"),
-        ("preset", "--preset"),
-        ("block", "--block"),
-    ];
-    FLAGS
-        .iter()
-        .find(|(name, _)| *name == option)
-        .map(|(_, flag)| flag.to_string())
+    use clap::CommandFactory;
+    let long = option.replace('_', "-");
+    let command = crate::args::Args::command();
+    let has = |c: &clap::Command| {
+        c.get_arguments()
+            .any(|a| a.get_long() == Some(long.as_str()))
+    };
+    (has(&command) || command.get_subcommands().any(has)).then(|| format!("--{long}"))
 }
 
 #[cfg(test)]
@@ -70,5 +53,21 @@ mod tests {
             explain(&e),
             "memory budget of 1.0 MiB: too much (--memory-budget)"
         );
+        // Every knob of the library's table has its flag, and the render's options theirs.
+        for knob in meshlight::solver::KNOBS {
+            let flag = flag(knob.name).unwrap_or_else(|| panic!("{} has no flag", knob.name));
+            assert_eq!(flag, format!("--{}", knob.name.replace('_', "-")));
+        }
+        for option in [
+            "gather_rays",
+            "glossy_rays",
+            "spp",
+            "patch_size",
+            "block",
+            "preset",
+        ] {
+            assert!(flag(option).is_some(), "{option}");
+        }
+        assert_eq!(flag("brightness"), None);
     }
 }

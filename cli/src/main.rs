@@ -297,8 +297,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         }
         Method::Meshless => {
             let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
-            let preset =
-                render_options_from(&r.solve.knobs, r.supersample, r.direct_rays, r.gather_rays)?;
+            let preset = render_options_from(&r.solve.knobs, &r.render)?;
             let render_options = meshlight::RenderOptions {
                 threads: options.threads,
                 supersample: preset.supersample,
@@ -307,7 +306,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
                     Some(FalseColor::Illuminance) => meshlight::Quantity::Irradiance,
                     _ => meshlight::Quantity::Radiance,
                 },
-                glossy_rays: r.glossy_rays,
+                glossy_rays: preset.glossy_rays,
                 gather_rays: preset.gather_rays,
                 memory_budget: options.memory_budget,
             };
@@ -356,7 +355,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
 /// The path tracer's settings from `render`'s arguments.
 fn path_options(r: &RenderArgs, options: &meshlight::Options) -> meshlight::reference::PathOptions {
     meshlight::reference::PathOptions {
-        spp: r.spp,
+        spp: r.render.spp,
         seconds: r.time,
         seed: options.seed,
         threads: options.threads,
@@ -373,11 +372,12 @@ fn patch_options(
     options: &meshlight::Options,
 ) -> anyhow::Result<meshlight::reference::PatchOptions> {
     Ok(meshlight::reference::PatchOptions {
-        patch_size: match r.patch_size {
+        patch_size: match r.render.patch_size {
             Some(h) => h,
             None => meshlight::solver::choose_epsilon(scene, options)?.0,
         },
         supersample: r
+            .render
             .supersample
             .unwrap_or(meshlight::RenderOptions::default().supersample)
             .max(1),

@@ -17,33 +17,16 @@ use plotters::style::RGBColor;
 use super::plot::{error_time_png, Series};
 use crate::Method;
 
-/// The settings `--vary` knows, as the command line spells them.
-const KEYS: &[&str] = &[
-    "preset",
-    "epsilon",
-    "epsilon-scale",
-    "zeta",
-    "alpha",
-    "rounds",
-    "light-samples",
-    "tolerance",
-    "max-shots",
-    "max-samples",
-    "cluster-threshold",
-    "exact-visibility",
-    "backend",
-    "threads",
-    "seed",
-    "supersample",
-    "direct-rays",
-    "gather-rays",
-    "specular-depth",
-    "specular-rays",
-    "photons",
-    "glossy-rays",
-    "patch-size",
-    "spp",
-];
+/// The settings `--vary` knows, as the command line spells them: the solver's knob table, then
+/// the preset, the backend and the render flags.
+fn keys() -> Vec<String> {
+    let knobs = meshlight::solver::KNOBS
+        .iter()
+        .map(|k| k.name.replace('_', "-"));
+    knobs
+        .chain(crate::args::RENDER_KEYS.iter().map(|k| k.to_string()))
+        .collect()
+}
 
 /// Added to the seed of the path tracer's curve, so it shares no random numbers with a
 /// reference traced with the sweep's own seed.
@@ -59,17 +42,8 @@ pub struct Sweep {
     pub epsilon: Option<f32>,
     /// The fixed knobs from the command line.
     pub knobs: super::Knobs,
-    /// Rays per side on edge pixels (meshless) or per pixel (patches); `None`: the preset's.
-    pub supersample: Option<u32>,
-    /// Meshless: shadow rays per area light at each camera hit (0: interpolated direct light);
-    /// `None`: the preset's.
-    pub direct_rays: Option<u32>,
-    /// Meshless: gather rays at hits near another surface; `None`: the preset's.
-    pub gather_rays: Option<u32>,
-    /// Patch side (patches; default the solver's ε).
-    pub patch_size: Option<f32>,
-    /// Samples per pixel (pathtrace).
-    pub spp: u32,
+    /// How each image is made, where the run does not vary it.
+    pub render: crate::args::RenderFlags,
     /// Output prefix: PREFIX.csv and PREFIX.png.
     pub out: PathBuf,
     /// Add the path tracer's curve (doubling spp) to the CSV and the plot.
@@ -89,11 +63,7 @@ impl From<crate::SweepArgs> for Sweep {
             method: a.method,
             epsilon: a.solve.epsilon,
             knobs: a.solve.knobs,
-            supersample: a.supersample,
-            direct_rays: a.direct_rays,
-            gather_rays: a.gather_rays,
-            patch_size: a.patch_size,
-            spp: a.spp,
+            render: a.render,
             out: a.out,
             pathtrace_curve: !a.no_pathtrace,
             block: a.block,
@@ -109,10 +79,11 @@ pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String>
         .split_once('=')
         .ok_or_else(|| format!("'{s}' is not key=value1,value2,..."))?;
     let key = key.trim().replace('_', "-");
-    if !KEYS.contains(&key.as_str()) {
+    let keys = keys();
+    if !keys.contains(&key) {
         return Err(format!(
             "unknown setting '{key}' (known: {})",
-            KEYS.join(", ")
+            keys.join(", ")
         ));
     }
     let values: Vec<String> = values
@@ -170,32 +141,23 @@ fn value<T: FromStr>(key: &str, v: &str) -> Result<T> {
         .map_err(|_| anyhow!("--vary {key}: '{v}' is not a valid value"))
 }
 
-/// Sets one varied setting (`preset` is applied before, when the options are made).
+/// Sets one varied setting (`preset` is applied before, when the options are made): a knob
+/// of the solver's table, or one of the render's.
 fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
+    if meshlight::solver::knob(key).is_some() {
+        return o.set(key, v).map_err(|e| match e {
+            meshlight::Error::Option { problem, .. } => anyhow!("--vary {key}: {problem}"),
+            other => anyhow!("--vary {key}: {other}"),
+        });
+    }
     match key {
         "preset" => {}
-        "epsilon" => o.epsilon = Some(value(key, v)?),
-        "epsilon-scale" => o.epsilon_scale = value(key, v)?,
-        "zeta" => o.zeta = value(key, v)?,
-        "alpha" => o.alpha = value(key, v)?,
-        "rounds" => o.rounds = value(key, v)?,
-        "light-samples" => o.light_samples = value(key, v)?,
-        "tolerance" => o.tolerance = value(key, v)?,
-        "max-shots" => o.max_shots = Some(value(key, v)?),
-        "max-samples" => o.max_samples = value(key, v)?,
-        "cluster-threshold" => o.cluster_threshold = value(key, v)?,
-        "exact-visibility" => o.exact_visibility = value(key, v)?,
         "backend" => {
             extra.backend = Backend::from_str(v).map_err(|e| anyhow!("--vary {key}: {e}"))?
         }
-        "threads" => o.threads = value::<usize>(key, v)?.max(1),
-        "seed" => o.seed = value(key, v)?,
         "supersample" => extra.supersample = value::<u32>(key, v)?.max(1),
         "direct-rays" => extra.direct_rays = value(key, v)?,
         "gather-rays" => extra.gather_rays = value(key, v)?,
-        "specular-depth" => o.specular_depth = value(key, v)?,
-        "specular-rays" => o.specular_rays = value(key, v)?,
-        "photons" => o.photons = value(key, v)?,
         "glossy-rays" => extra.glossy_rays = value(key, v)?,
         "patch-size" => extra.patch_size = Some(value(key, v)?),
         "spp" => extra.spp = value(key, v)?,
@@ -271,12 +233,7 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             }
         }
         let mut options = super::options_from(sweep.epsilon, &knobs)?;
-        let render = super::render_options_from(
-            &knobs,
-            sweep.supersample,
-            sweep.direct_rays,
-            sweep.gather_rays,
-        )?;
+        let render = super::render_options_from(&knobs, &sweep.render)?;
         let mut extra = Extra {
             supersample: render.supersample,
             direct_rays: match render.direct {
@@ -284,9 +241,9 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
                 meshlight::Direct::Traced { light_samples } => light_samples,
             },
             gather_rays: render.gather_rays,
-            glossy_rays: meshlight::RenderOptions::default().glossy_rays,
-            patch_size: sweep.patch_size,
-            spp: sweep.spp,
+            glossy_rays: render.glossy_rays,
+            patch_size: sweep.render.patch_size,
+            spp: sweep.render.spp,
             block: sweep.block,
             backend: super::backend_from(&sweep.knobs),
         };
@@ -612,6 +569,39 @@ fn plot(path: &Path, scene: &Scene, method: Method, rows: &[Row], curve: &[Row])
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_key_is_a_flag_of_the_sweep_and_every_setting_flag_a_key() {
+        use clap::CommandFactory;
+        let command = crate::args::Args::command();
+        let sweep = command.find_subcommand("sweep").unwrap();
+        let flags: Vec<&str> = sweep.get_arguments().filter_map(|a| a.get_long()).collect();
+        let keys = keys();
+        for key in &keys {
+            assert!(flags.contains(&key.as_str()), "--vary {key} is not a flag");
+        }
+        // The render's flags that set how an image is made are keys too.
+        let render = command.find_subcommand("render").unwrap();
+        let not_settings = [
+            "output",
+            "width",
+            "height",
+            "method",
+            "time",
+            "false-color",
+            "range",
+            "log",
+        ];
+        for flag in render.get_arguments().filter_map(|a| a.get_long()) {
+            let global = ["strict", "max-reflectance", "camera", "quiet", "help"];
+            if !not_settings.contains(&flag) && !global.contains(&flag) {
+                assert!(
+                    keys.iter().any(|k| k == flag),
+                    "render --{flag} cannot be varied"
+                );
+            }
+        }
+    }
 
     #[test]
     fn vary_parses_and_refuses() {

@@ -16,11 +16,10 @@ mod split;
 use glam::{DVec3, Vec2};
 
 use crate::error::Result;
+use crate::exec::Exec;
 use crate::parallel::{for_chunks, Report};
 use crate::sampling::shares::{self, Shares};
-use crate::sampling::{
-    surface_of, AreaCell, Obstruction, Samples, SideIndex, SurfaceMap, CELL_UNITS,
-};
+use crate::sampling::{surface_of, AreaCell, Samples, SurfaceMap, CELL_UNITS};
 use crate::visibility::Visibility;
 
 /// What the area computation did.
@@ -35,25 +34,23 @@ pub struct AreaStats {
     pub queries: u64,
 }
 
-/// Computes every sample's area `S`, on up to `threads` threads and over `ranks` (the result
-/// depends on neither: the split's runs are dealt to the ranks and all-gathered). With
+/// Computes every sample's area `S` with the fall-off `alpha`, on `exec`'s threads and ranks
+/// (the result depends on neither: the split's runs are dealt to the ranks and all-gathered). With
 /// `changed` (per side), only the sides it marks are recomputed: the
 /// others keep the cells and shares the last computation gave them (their samples and radii
 /// must not have changed since). `report` hears the share of cells done now and then; if it
 /// answers Stop, the cells not split yet go whole to their nearest sample, so every side's
 /// area is still conserved.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn compute(
     samples: &mut Samples,
-    maps: &[SurfaceMap],
-    index: &SideIndex,
-    obstruction: &Obstruction,
+    places: &crate::sampling::Layout,
     vis: &dyn Visibility,
-    (epsilon, alpha): (f32, f32),
-    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
+    alpha: f32,
+    exec: Exec,
     changed: Option<&[bool]>,
     report: Report,
 ) -> Result<AreaStats> {
+    let (maps, epsilon, threads) = (places.maps(), places.epsilon(), exec.threads);
     let sides = 2 * maps.len();
     let redo = |side: usize| changed.is_none_or(|c| c.get(side).copied().unwrap_or(true));
     let kept = if changed.is_some() {
@@ -68,17 +65,17 @@ pub(crate) fn compute(
     };
     let reads = split::Reads {
         maps,
-        index,
-        obstruction,
+        index: places.index(),
+        obstruction: places.obstruction(),
         vis,
         alpha,
     };
-    let runs = split::Splitter::new(samples, reads).count(&layout, threads, ranks, report)?;
+    let runs = split::Splitter::new(samples, reads).count(&layout, threads, exec.ranks, report)?;
     for run in &runs {
         stats.queries += run.queries;
         stats.orphan_cells += run.orphans;
     }
-    gather_shares(samples, reads, layout, runs, &redo, (threads, ranks))?;
+    gather_shares(samples, reads, layout, runs, &redo, exec)?;
     region_centroids(samples, threads)?;
     Ok(stats)
 }
@@ -220,8 +217,9 @@ fn gather_shares(
     layout: Layout,
     mut runs: Vec<split::Run>,
     redo: &dyn Fn(usize) -> bool,
-    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
+    exec: Exec,
 ) -> Result<()> {
+    let (threads, ranks) = (exec.threads, exec.ranks);
     let maps = reads.maps;
     let n = samples.len();
     // Samples of the last computation on sides that did not change keep their shares.

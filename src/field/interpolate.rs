@@ -85,8 +85,8 @@ impl<'a> Interpolator<'a> {
     /// final gather, each a small share of its answer, where kernels and their visibility
     /// queries would cost more than the rest of the render.
     pub(crate) fn nearest(&self, site: &Site) -> Option<u32> {
-        let (s, index) = (&self.field.samples, &self.field.layout.index);
-        let uv = self.field.layout.maps[surface_of(site.side) as usize].to_2d(site.point);
+        let (s, index) = (&self.field.samples, &self.field.layout.index());
+        let uv = self.field.layout.maps()[surface_of(site.side) as usize].to_2d(site.point);
         index
             .nearest_where(s, site.side, uv, |k| {
                 self.sample_covered(k as usize) == site.covered
@@ -103,7 +103,7 @@ impl<'a> Interpolator<'a> {
     pub(crate) fn covered(&self, points: &[(Vec3, Vec3)]) -> Result<Vec<bool>> {
         let covers: Vec<Segment> = points
             .iter()
-            .map(|&(p, n)| cover::segment(p, n, self.lift, self.field.layout.epsilon))
+            .map(|&(p, n)| cover::segment(p, n, self.lift, self.field.layout.epsilon()))
             .collect();
         let mut answers = vec![false; covers.len()];
         self.vis.occluded(&covers, &mut answers)?;
@@ -120,17 +120,17 @@ impl<'a> Interpolator<'a> {
         let mut segments = Vec::new();
         let mut near = Vec::new();
         for site in sites {
-            let map = &self.field.layout.maps[surface_of(site.side) as usize];
+            let map = &self.field.layout.maps()[surface_of(site.side) as usize];
             let from = site.point + self.lift * site.normal;
             let uv = map.to_2d(site.point);
             let reach = self.support[site.side as usize];
             self.field
                 .layout
-                .index
+                .index()
                 .within(s, site.side, uv, reach, &mut near);
             near.sort_unstable_by_key(|&(k, _)| k);
             let start = candidates.len();
-            let test = self.field.layout.obstruction.is_obstructed(site.side);
+            let test = self.field.layout.obstruction().is_obstructed(site.side);
             for &(k, d2) in &near {
                 let r = SUPPORT * s.radius[k as usize];
                 let q = d2 / (r * r);
@@ -175,7 +175,7 @@ impl<'a> Interpolator<'a> {
                 queries += q;
                 chosen.extend(nearest.map(|k| (k, 1.0)));
             } else if self.linear {
-                let map = &self.field.layout.maps[surface_of(site.side) as usize];
+                let map = &self.field.layout.maps()[surface_of(site.side) as usize];
                 let at = map.to_2d(site.point);
                 // Each value is its region's average, which a linear field takes at the
                 // region's centroid: the fit places the values there.
@@ -196,7 +196,7 @@ impl<'a> Interpolator<'a> {
 
     /// Whether sample k is covered (`sampling::cover`); a solution without the flags has none.
     fn sample_covered(&self, k: usize) -> bool {
-        self.field.layout.covered.get(k).copied().unwrap_or(false)
+        self.field.layout.covered().get(k).copied().unwrap_or(false)
     }
 
     /// Fallback where no sample's kernel reaches a visible point: the nearest visible sample of
@@ -204,7 +204,7 @@ impl<'a> Interpolator<'a> {
     fn nearest_visible(&self, side: Side, point: Vec3) -> Result<(Option<u32>, u64)> {
         let s = &self.field.samples;
         let surface = surface_of(side);
-        let map = &self.field.layout.maps[surface as usize];
+        let map = &self.field.layout.maps()[surface as usize];
         let normal = if is_back(side) {
             -map.normal
         } else {
@@ -217,7 +217,7 @@ impl<'a> Interpolator<'a> {
         let mut r = self.support[side as usize];
         for _ in 0..4 {
             r *= 2.0;
-            self.field.layout.index.within(s, side, uv, r, &mut near);
+            self.field.layout.index().within(s, side, uv, r, &mut near);
             near.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
             near.truncate(16);
             let segments: Vec<Segment> = near

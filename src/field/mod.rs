@@ -2,14 +2,15 @@
 //! what reading that light at any other point takes (the surfaces in 2D, the samples' index,
 //! the sides other geometry stands on, the samples something hovers over). The solver builds
 //! it; the render, the grids, the PLY writer and the specular chains' ends only read it, through
-//! [`interpolate`] and the accessors here.
+//! [`interpolate`] and the accessors here. Where the samples lie (`sampling::Layout`) is the
+//! solver's to grow and the field's to keep.
 
 pub(crate) mod interpolate;
 
 use glam::DVec3;
 
 use crate::light::Arrival;
-use crate::sampling::{vec_bytes, Obstruction, Samples, SideIndex, SurfaceMap};
+use crate::sampling::{Layout, Samples};
 
 /// The samples and their light, as a solve leaves them.
 #[derive(Clone, Debug)]
@@ -31,81 +32,6 @@ pub struct Field {
     pub(crate) specular: bool,
     /// Where the samples lie, for reading the field between them.
     pub(crate) layout: Layout,
-}
-
-/// What reading the field between samples takes, kept from the solve: built and grown by the
-/// solver as it places samples, read by interpolation.
-#[derive(Clone, Debug)]
-pub(crate) struct Layout {
-    /// The Poisson-disk spacing ε the samples were placed with.
-    epsilon: f32,
-    /// The surfaces in 2D.
-    maps: Vec<SurfaceMap>,
-    /// Range queries over the samples.
-    index: SideIndex,
-    /// Which sides other geometry stands on.
-    obstruction: Obstruction,
-    /// Per sample: whether something hovers over it (see `sampling::cover`).
-    covered: Vec<bool>,
-}
-
-impl Layout {
-    /// The layout of a solve that has placed no samples yet.
-    pub(crate) fn new(epsilon: f32, maps: Vec<SurfaceMap>, obstruction: Obstruction) -> Layout {
-        Layout {
-            epsilon,
-            maps,
-            index: SideIndex::default(),
-            obstruction,
-            covered: Vec::new(),
-        }
-    }
-
-    /// The surfaces in 2D, one per surface.
-    pub(crate) fn maps(&self) -> &[SurfaceMap] {
-        &self.maps
-    }
-
-    /// Range queries over the samples (as of the last [`Layout::reindex`]).
-    pub(crate) fn index(&self) -> &SideIndex {
-        &self.index
-    }
-
-    /// Which sides other geometry stands on.
-    pub(crate) fn obstruction(&self) -> &Obstruction {
-        &self.obstruction
-    }
-
-    /// Per sample: whether something hovers over it.
-    pub(crate) fn covered(&self) -> &[bool] {
-        &self.covered
-    }
-
-    /// Indexes `samples` anew (after samples were added).
-    pub(crate) fn reindex(&mut self, samples: &Samples) {
-        self.index = SideIndex::new(samples, &self.maps, self.epsilon);
-    }
-
-    /// Drops the index (a test's broken solution).
-    #[cfg(test)]
-    pub(crate) fn forget_index(&mut self) {
-        self.index = SideIndex::default();
-    }
-
-    /// Appends the cover flags of newly added samples.
-    pub(crate) fn cover(&mut self, flags: &[bool]) {
-        self.covered.reserve_exact(flags.len());
-        self.covered.extend_from_slice(flags);
-    }
-
-    /// Bytes of the index, the cover flags and the maps.
-    pub(crate) fn bytes(&self) -> (usize, usize, usize) {
-        (
-            self.index.bytes(),
-            vec_bytes(&self.covered),
-            self.maps.iter().map(|m| vec_bytes(&m.triangles)).sum(),
-        )
-    }
 }
 
 impl Field {
@@ -131,7 +57,7 @@ impl Field {
 
     /// The Poisson-disk spacing ε of the samples.
     pub fn epsilon(&self) -> f32 {
-        self.layout.epsilon
+        self.layout.epsilon()
     }
 
     /// The specular depth the field was solved with.

@@ -599,12 +599,13 @@ impl DirectLight {
         // Per receiver, emitter and way: analytic irradiance, the unoccluded form factor
         // (emitters that do not reflect, straight), and Σ weights, Σ weights × share of its
         // shadow rays.
-        let mut analytic = vec![DVec3::ZERO; points.len() * slots];
-        let mut factor = vec![0.0f64; points.len() * slots];
-        let mut weights = vec![(0.0f64, DVec3::ZERO); points.len() * slots];
-        let mut paths = Vec::new();
-        // Per shadow ray: (slot, weight).
-        let mut rays: Vec<(usize, f64)> = Vec::new();
+        let mut tally = Tally {
+            analytic: vec![DVec3::ZERO; points.len() * slots],
+            factor: vec![0.0f64; points.len() * slots],
+            weights: vec![(0.0f64, DVec3::ZERO); points.len() * slots],
+            paths: Vec::new(),
+            rays: Vec::new(),
+        };
         let mut draw = spherical::Draw::default();
         for (r, (&(x, n), &id)) in points.iter().zip(ids).enumerate() {
             let from = x + self.lift * n;
@@ -629,18 +630,32 @@ impl DirectLight {
                         }
                     }
                     let slot = (r * ways + w) * ne + e;
+                    let seen = Seen {
+                        x,
+                        n,
+                        from,
+                        slot,
+                        chain,
+                        straight: w == 0,
+                    };
                     self.emitter_rays(
                         emitter,
-                        (x, n, from),
-                        (slot, chain, w == 0),
-                        (&mut rng, &mut draw),
-                        (&mut analytic, &mut factor, &mut weights),
-                        (&mut paths, &mut rays),
+                        &seen,
+                        &mut rng,
+                        &mut draw,
+                        &mut tally,
                         unoccluded.get_mut(r).expect("one per receiver"),
                     );
                 }
             }
         }
+        let Tally {
+            analytic,
+            factor,
+            mut weights,
+            paths,
+            rays,
+        } = tally;
         let mut shares = vec![DVec3::ZERO; paths.len()];
         let queries = self.shares(vis, &paths, &mut shares)?;
         for (&(slot, weight), share) in rays.iter().zip(&shares) {
@@ -663,28 +678,33 @@ impl DirectLight {
     /// One emitter (or its image) seen from receiver x: its analytic irradiance, and its
     /// shadow rays on a Fibonacci lattice shifted at random per receiver (Cranley and
     /// Patterson): as even in two dimensions as a grid for any count, and unbiased.
-    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     fn emitter_rays<'c>(
         &self,
         emitter: &Emitter,
-        (x, n, from): (Vec3, Vec3, Vec3),
-        (slot, chain, straight): (usize, &'c [u32], bool),
-        (rng, draw): (&mut Pcg64Mcg, &mut spherical::Draw),
-        (analytic, factor, weights): (&mut [DVec3], &mut [f64], &mut [(f64, DVec3)]),
-        (paths, rays): (&mut Vec<LightPath<'c>>, &mut Vec<(usize, f64)>),
+        seen: &Seen<'c>,
+        rng: &mut Pcg64Mcg,
+        draw: &mut spherical::Draw,
+        tally: &mut Tally<'c>,
         unoccluded: &mut f64,
     ) {
         if !emitter.facets.is_empty() {
-            return self.facet_rays(
-                emitter,
-                (x, n, from),
-                (slot, chain, straight),
-                rng,
-                (analytic, factor, weights),
-                (paths, rays),
-                unoccluded,
-            );
+            return self.facet_rays(emitter, seen, rng, tally, unoccluded);
         }
+        let Seen {
+            x,
+            n,
+            from,
+            slot,
+            chain,
+            straight,
+        } = *seen;
+        let Tally {
+            analytic,
+            factor,
+            weights,
+            paths,
+            rays,
+        } = tally;
         // Emitters light only what lies in front of them.
         let height = emitter.normal.dot(x) - emitter.offset;
         if height <= 0.0 {
@@ -768,17 +788,29 @@ impl DirectLight {
     /// analytic irradiance summed over the triangles facing x, and the shadow rays spread over
     /// the triangles by their share of it (uniform over each triangle's area), so one ray budget
     /// serves the whole light whatever its tessellation.
-    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     fn facet_rays<'c>(
         &self,
         emitter: &Emitter,
-        (x, n, from): (Vec3, Vec3, Vec3),
-        (slot, chain, straight): (usize, &'c [u32], bool),
+        seen: &Seen<'c>,
         rng: &mut Pcg64Mcg,
-        (analytic, factor, weights): (&mut [DVec3], &mut [f64], &mut [(f64, DVec3)]),
-        (paths, rays): (&mut Vec<LightPath<'c>>, &mut Vec<(usize, f64)>),
+        tally: &mut Tally<'c>,
         unoccluded: &mut f64,
     ) {
+        let Seen {
+            x,
+            n,
+            from,
+            slot,
+            chain,
+            straight,
+        } = *seen;
+        let Tally {
+            analytic,
+            factor,
+            weights,
+            paths,
+            rays,
+        } = tally;
         // Per facing triangle: (triangle, its irradiance, cumulative irradiance).
         let mut facing: Vec<(usize, f64, f64)> = Vec::new();
         let mut irradiance = 0.0;
@@ -837,6 +869,30 @@ impl DirectLight {
             rays.push((slot, weight));
         }
     }
+}
+
+/// A receiver as one emitter (or one of its images) sees it: the point, its normal, where its
+/// shadow rays start, and the slot their tally goes to (receiver × way × emitter) with the
+/// chain of reflectors the way passes (none straight).
+#[derive(Clone, Copy)]
+struct Seen<'c> {
+    x: Vec3,
+    n: Vec3,
+    from: Vec3,
+    slot: usize,
+    chain: &'c [u32],
+    straight: bool,
+}
+
+/// Per slot, what a batch of receivers' area lights add up to: the analytic irradiance, the
+/// unoccluded form factor to dark emitters, Σ weights and Σ weights × visible share; and the
+/// shadow rays to trace, each with its slot and weight.
+struct Tally<'c> {
+    analytic: Vec<DVec3>,
+    factor: Vec<f64>,
+    weights: Vec<(f64, DVec3)>,
+    paths: Vec<LightPath<'c>>,
+    rays: Vec<(usize, f64)>,
 }
 
 /// Irradiance at x (normal n) from a triangle of unit radiance emitting towards x: Lambert's

@@ -137,7 +137,26 @@ impl Shader<'_> {
         if spots.is_empty() {
             return Ok((Vec::new(), 0));
         }
-        let n = rays as usize;
+        let cast = self.cast(spots, rays)?;
+        let mut queries = cast.casts.len() as u64;
+        let sites = self.sites(&cast)?;
+        let (weights, mut parts, q) = self.read_sites(spots, &cast, &sites)?;
+        queries += q;
+        // Sites within their spot's reach gather in turn.
+        let (next, next_of) = if levels > 0 {
+            self.next_spots(spots, &cast, &sites, &weights)
+        } else {
+            (Vec::new(), vec![None; sites.sites.len()])
+        };
+        let (again, q) = self.gather_at(&next, NEXT_RAYS, levels.saturating_sub(1))?;
+        queries += q;
+        queries += self.trace_direct(&next, &next_of, &mut parts)?;
+        let out = combine(spots, &cast, &sites, &parts, &next_of, &again);
+        Ok((out, queries))
+    }
+
+    /// `rays` cosine-distributed rays from each spot, and what they hit.
+    fn cast(&self, spots: &[Spot], rays: u32) -> Result<Cast> {
         let casts: Vec<Ray> = spots
             .iter()
             .flat_map(|spot| {
@@ -152,13 +171,21 @@ impl Shader<'_> {
             .collect();
         let mut found = vec![None; casts.len()];
         self.vis.intersect(&casts, &mut found)?;
-        let mut queries = casts.len() as u64;
+        Ok(Cast {
+            casts,
+            found,
+            per_spot: rays as usize,
+        })
+    }
+
+    /// The hits that reflect sampled light, as sites to read, with their reflectance (their
+    /// texel, or their material's) and whether something hovers over each (so it reads samples
+    /// covered as it is: the floor under a box is dark).
+    fn sites(&self, cast: &Cast) -> Result<Sites> {
         let mut sites = Vec::new();
-        // The reflectance at each site: its texel, or its material's.
         let mut reflectance = Vec::new();
-        // Per gather ray: its site's index, if its hit reflects sampled light.
-        let mut site_of = vec![None; casts.len()];
-        for (j, (ray, hit)) in casts.iter().zip(&found).enumerate() {
+        let mut site_of = vec![None; cast.casts.len()];
+        for (j, (ray, hit)) in cast.casts.iter().zip(&cast.found).enumerate() {
             let Some(Hit { t, triangle }) = *hit else {
                 continue;
             };
@@ -181,32 +208,46 @@ impl Shader<'_> {
                 .unwrap_or_else(|| self.scene.material_of(tri.surface).kd);
             reflectance.push(rho.as_dvec3());
         }
-        // Whether something hovers over each site, so it reads samples covered as it is (the
-        // floor under a box is dark).
         let points: Vec<(Vec3, Vec3)> = sites.iter().map(|s| (s.point, s.normal)).collect();
         let covered = self.interpolator.covered(&points)?;
         for (site, covered) in sites.iter_mut().zip(covered) {
             site.covered = covered;
         }
-        // Sites within their spot's reach lie along the crease, where the light changes
-        // fastest: they are interpolated in full (kernels, samples in sight, the local-linear
-        // fit). The far ones, most of them, read their nearest sample: each is a small share
-        // of a smooth answer, and their kernels' visibility queries cost more than the rest
-        // of the render (on the gallery, 2.9 s of render against 5.4 s).
-        let mut near_site = vec![false; sites.len()];
-        for (j, found) in found.iter().enumerate() {
-            if let (Some(s), Some(hit)) = (site_of[j], found) {
-                near_site[s] = hit.t < spots[j / n].reach;
+        Ok(Sites {
+            sites,
+            reflectance,
+            site_of,
+        })
+    }
+
+    /// Each site's samples and weights, and its direct and inter-reflected light per unit
+    /// reflectance read from them; the queries. Sites within their spot's reach lie along the
+    /// crease, where the light changes fastest: they are interpolated in full (kernels, samples
+    /// in sight, the local-linear fit). The far ones, most of them, read their nearest sample:
+    /// each is a small share of a smooth answer, and their kernels' visibility queries cost
+    /// more than the rest of the render (on the gallery, 2.9 s of render against 5.4 s).
+    fn read_sites(
+        &self,
+        spots: &[Spot],
+        cast: &Cast,
+        sites: &Sites,
+    ) -> Result<(Vec<Weights>, Vec<Light>, u64)> {
+        let sites_list = &sites.sites;
+        let mut near_site = vec![false; sites_list.len()];
+        for (j, found) in cast.found.iter().enumerate() {
+            if let (Some(s), Some(hit)) = (sites.site_of[j], found) {
+                near_site[s] = hit.t < spots[j / cast.per_spot].reach;
             }
         }
-        let close: Vec<Site> = (0..sites.len())
+        let close: Vec<Site> = (0..sites_list.len())
             .filter(|&s| near_site[s])
-            .map(|s| sites[s])
+            .map(|s| sites_list[s])
             .collect();
         let mut interpolated = Vec::new();
-        queries += self.interpolator.weights(&close, &mut interpolated)? + sites.len() as u64;
+        let queries =
+            self.interpolator.weights(&close, &mut interpolated)? + sites_list.len() as u64;
         let mut interpolated = interpolated.into_iter();
-        let weights: Vec<Vec<(u32, f32)>> = sites
+        let weights: Vec<Vec<(u32, f32)>> = sites_list
             .iter()
             .zip(&near_site)
             .map(|(site, &near)| match near {
@@ -217,8 +258,7 @@ impl Shader<'_> {
                     .map_or_else(Vec::new, |k| vec![(k, 1.0)]),
             })
             .collect();
-        // Each site's direct and inter-reflected light per unit reflectance, interpolated.
-        let mut parts: Vec<(DVec3, DVec3)> = weights
+        let parts = weights
             .iter()
             .map(|chosen| {
                 let (mut wsum, mut direct, mut reflected) = (0.0f64, DVec3::ZERO, DVec3::ZERO);
@@ -238,70 +278,124 @@ impl Shader<'_> {
                 }
             })
             .collect();
-
-        // Sites within their spot's reach gather in turn.
-        let mut next = Vec::new();
-        let mut next_of = vec![None; sites.len()];
-        if levels > 0 {
-            for (j, found) in found.iter().enumerate() {
-                let (Some(s), Some(hit)) = (site_of[j], found) else {
-                    continue;
-                };
-                if hit.t < spots[j / n].reach {
-                    next_of[s] = Some(next.len());
-                    next.push(Spot {
-                        point: sites[s].point,
-                        normal: sites[s].normal,
-                        reach: self.reach(&weights[s]),
-                        seed: seed(spots[j / n].seed, j as u64),
-                    });
-                }
-            }
-        }
-        let (again, q) = self.gather_at(&next, NEXT_RAYS, levels.saturating_sub(1))?;
-        queries += q;
-        // Their direct light too is traced, not interpolated: beside a contact the other
-        // surface's direct light changes as fast as its inter-reflected light (the floor at a
-        // box's foot lies in the box's shadow), and reads too bright from its samples.
-        if let (Some(light), false) = (&self.near_light, next.is_empty()) {
-            let points: Vec<(Vec3, Vec3)> = next.iter().map(|n| (n.point, n.normal)).collect();
-            let ids: Vec<u32> = next.iter().map(|n| n.seed as u32).collect();
-            let mut arrivals = vec![crate::light::Arrival::default(); next.len()];
-            queries += light.batch(self.vis, &points, &ids, NEAR_DIRECT_SEED, &mut arrivals)?;
-            for (s, m) in next_of.iter().enumerate() {
-                if let Some(m) = *m {
-                    parts[s].0 = arrivals[m].irradiance / std::f64::consts::PI;
-                }
-            }
-        }
-
-        let out = spots
-            .iter()
-            .enumerate()
-            .map(|(i, spot)| {
-                let (mut radiance, mut close) = (DVec3::ZERO, 0usize);
-                for j in i * n..(i + 1) * n {
-                    if let Some(s) = site_of[j] {
-                        let (direct, mut reflected) = parts[s];
-                        if let Some(g) = next_of[s].map(|m| again[m]) {
-                            let gathered = g.irradiance / std::f64::consts::PI;
-                            reflected += f64::from(g.alpha) * (gathered - reflected);
-                        }
-                        radiance += reflectance[s] * (direct + reflected);
-                    }
-                    if found[j].is_some_and(|h| h.t < spot.reach) {
-                        close += 1;
-                    }
-                }
-                // Cosine-weighted directions: the irradiance is π times the mean radiance.
-                Gathered {
-                    alpha: (2.0 * close as f32 / n as f32).min(1.0),
-                    irradiance: radiance * std::f64::consts::PI / n as f64,
-                }
-            })
-            .collect();
-        Ok((out, queries))
+        Ok((weights, parts, queries))
     }
+
+    /// The sites within their spot's reach, as the spots of the next level, and which spot
+    /// each site became.
+    fn next_spots(
+        &self,
+        spots: &[Spot],
+        cast: &Cast,
+        sites: &Sites,
+        weights: &[Vec<(u32, f32)>],
+    ) -> (Vec<Spot>, Vec<Option<usize>>) {
+        let mut next = Vec::new();
+        let mut next_of = vec![None; sites.sites.len()];
+        for (j, found) in cast.found.iter().enumerate() {
+            let (Some(s), Some(hit)) = (sites.site_of[j], found) else {
+                continue;
+            };
+            let spot = &spots[j / cast.per_spot];
+            if hit.t < spot.reach {
+                next_of[s] = Some(next.len());
+                next.push(Spot {
+                    point: sites.sites[s].point,
+                    normal: sites.sites[s].normal,
+                    reach: self.reach(&weights[s]),
+                    seed: seed(spot.seed, j as u64),
+                });
+            }
+        }
+        (next, next_of)
+    }
+
+    /// The next level's direct light, traced, not interpolated: beside a contact the other
+    /// surface's direct light changes as fast as its inter-reflected light (the floor at a
+    /// box's foot lies in the box's shadow), and reads too bright from its samples. Into
+    /// `parts`; the queries.
+    fn trace_direct(
+        &self,
+        next: &[Spot],
+        next_of: &[Option<usize>],
+        parts: &mut [Light],
+    ) -> Result<u64> {
+        let Some(light) = self.near_light.as_ref().filter(|_| !next.is_empty()) else {
+            return Ok(0);
+        };
+        let points: Vec<(Vec3, Vec3)> = next.iter().map(|n| (n.point, n.normal)).collect();
+        let ids: Vec<u32> = next.iter().map(|n| n.seed as u32).collect();
+        let mut arrivals = vec![crate::light::Arrival::default(); next.len()];
+        let queries = light.batch(self.vis, &points, &ids, NEAR_DIRECT_SEED, &mut arrivals)?;
+        for (s, m) in next_of.iter().enumerate() {
+            if let Some(m) = *m {
+                parts[s].0 = arrivals[m].irradiance / std::f64::consts::PI;
+            }
+        }
+        Ok(queries)
+    }
+}
+
+/// The samples a site reads, with their weights.
+type Weights = Vec<(u32, f32)>;
+
+/// A site's direct and inter-reflected light per unit reflectance.
+type Light = (DVec3, DVec3);
+
+/// The rays a level of spots cast, and their hits.
+struct Cast {
+    casts: Vec<Ray>,
+    found: Vec<Option<Hit>>,
+    /// Rays per spot (spot i cast rays i × per_spot ..).
+    per_spot: usize,
+}
+
+/// The hits that reflect sampled light.
+struct Sites {
+    sites: Vec<Site>,
+    /// Each site's reflectance.
+    reflectance: Vec<DVec3>,
+    /// Per ray: its site, if its hit is one.
+    site_of: Vec<Option<usize>>,
+}
+
+/// Each spot's gathered light: its rays' sites' light (direct and inter-reflected, the latter
+/// blended with what the sites gathered again), and how much of the answer comes from within
+/// the spot's reach.
+fn combine(
+    spots: &[Spot],
+    cast: &Cast,
+    sites: &Sites,
+    parts: &[Light],
+    next_of: &[Option<usize>],
+    again: &[Gathered],
+) -> Vec<Gathered> {
+    let n = cast.per_spot;
+    spots
+        .iter()
+        .enumerate()
+        .map(|(i, spot)| {
+            let (mut radiance, mut close) = (DVec3::ZERO, 0usize);
+            for j in i * n..(i + 1) * n {
+                if let Some(s) = sites.site_of[j] {
+                    let (direct, mut reflected) = parts[s];
+                    if let Some(g) = next_of[s].map(|m| again[m]) {
+                        let gathered = g.irradiance / std::f64::consts::PI;
+                        reflected += f64::from(g.alpha) * (gathered - reflected);
+                    }
+                    radiance += sites.reflectance[s] * (direct + reflected);
+                }
+                if cast.found[j].is_some_and(|h| h.t < spot.reach) {
+                    close += 1;
+                }
+            }
+            // Cosine-weighted directions: the irradiance is π times the mean radiance.
+            Gathered {
+                alpha: (2.0 * close as f32 / n as f32).min(1.0),
+                irradiance: radiance * std::f64::consts::PI / n as f64,
+            }
+        })
+        .collect()
 }
 
 /// A hit's own seed: the same rays whatever the thread or rank that shades it.

@@ -279,11 +279,12 @@ pub fn render_distributed(
             Ok(())
         };
         // Each rank a run of the rows (a Stop heard before leaves them all black).
+        // Every ray seeds its own shadow rays by its pixel: the stage needs no seed.
+        let exec = crate::exec::Exec::new(options.threads, 0, ranks);
         let all = crate::distributed::for_share(
-            ranks,
+            exec,
             &mut centre,
             w,
-            options.threads,
             |first, out, _: &_| trace(first, out),
             &mut |f| {
                 control(reporter.report(Progress {
@@ -320,10 +321,9 @@ pub fn render_distributed(
         };
         // Each rank a run of the edge pixels (none after a Stop: `edges` is empty then).
         let refined_all = crate::distributed::for_share(
-            ranks,
+            exec,
             &mut refined,
             16,
-            options.threads,
             |first, out, _: &_| refine(first, out),
             &mut |f| {
                 control(reporter.report(Progress {

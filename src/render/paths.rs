@@ -55,6 +55,20 @@ struct Branch {
     lobe_pdf: Option<(f64, u32)>,
 }
 
+/// What the paths of a batch of camera rays gather as they go.
+struct Walk {
+    /// Directions a first glossy bounce draws.
+    fan: u32,
+    /// Per camera ray: the radiance so far, and the side (or path) its main branch sees.
+    radiance: Vec<DVec3>,
+    sides: Vec<u32>,
+    /// Surfaces with samples the paths end at: (pending hit, camera ray, weight).
+    ends: Vec<(Pending, usize, DVec3)>,
+    shadowed: Vec<Shadowed>,
+    /// Scratch for a bounce's light samples.
+    samples: Vec<LightSample>,
+}
+
 /// A light sample's shadow path waiting for its answer.
 struct Shadowed {
     origin: usize,
@@ -73,13 +87,14 @@ impl Shader<'_> {
         out: &mut [(Vec3, u32)],
         share: u32,
     ) -> Result<u64> {
-        let fan = (paths.glossy_rays / share.max(1)).max(1);
-        let lift = self.lift;
-        let mut radiance = vec![DVec3::ZERO; rays.len()];
-        let mut sides = vec![u32::MAX; rays.len()];
-        // Surfaces with samples the paths end at: (pending hit, camera ray, weight).
-        let mut ends: Vec<(Pending, usize, DVec3)> = Vec::new();
-        let mut shadowed: Vec<Shadowed> = Vec::new();
+        let mut walk = Walk {
+            fan: (paths.glossy_rays / share.max(1)).max(1),
+            radiance: vec![DVec3::ZERO; rays.len()],
+            sides: vec![u32::MAX; rays.len()],
+            ends: Vec::new(),
+            shadowed: Vec::new(),
+            samples: Vec::new(),
+        };
         let mut level: Vec<Branch> = rays
             .iter()
             .enumerate()
@@ -96,7 +111,6 @@ impl Shader<'_> {
             })
             .collect();
         let mut queries = 0u64;
-        let mut samples = Vec::new();
         while !level.is_empty() {
             let level_rays: Vec<Ray> = level.iter().map(|b| b.ray).collect();
             let mut hits = vec![None; level_rays.len()];
@@ -104,151 +118,190 @@ impl Shader<'_> {
             queries += level_rays.len() as u64;
             let mut next = Vec::new();
             for (b, hit) in level.iter().zip(&hits) {
-                let Some(hit) = hit else {
-                    // Out of the model (through a pane, by a mirror): the sky or the ground.
-                    if let Some(d) = self.scene.daylight() {
-                        if self.quantity == Quantity::Radiance {
-                            // The sun's disc only along delta paths: a glossy lobe's rays are
-                            // not weighed against the sun's.
-                            let sun = if b.lobe_pdf.is_none() {
-                                d.sun_radiance(b.ray.dir)
-                            } else {
-                                0.0
-                            };
-                            radiance[b.origin] += b.weight * (d.radiance(b.ray.dir) + sun);
-                        }
-                    }
-                    continue;
-                };
-                let tri = &self.scene.triangles[hit.triangle as usize];
-                let dir = b.ray.dir.normalize();
-                let back = dir.dot(tri.normal) > 0.0;
-                let side = side_of(tri.surface, back);
-                if b.main {
-                    // A side id past the scene's sides stands for a path: which side it met
-                    // at which depth.
-                    sides[b.origin] = if b.depth == 0 {
-                        side
-                    } else {
-                        let n = 2 * self.scene.surfaces.len() as u32;
-                        n.wrapping_mul(b.depth).wrapping_add(side)
-                    };
-                }
-                let point = b.ray.origin + hit.t * b.ray.dir;
-                let material = self.scene.material_of(tri.surface);
-                let normal = if back { -tri.normal } else { tri.normal };
-                if self.interpolator.has_samples(side) {
-                    ends.push((
-                        Pending {
-                            side,
-                            fixed: None,
-                            point,
-                            normal,
-                            traced: b.traced,
-                            texel: self.texel(hit.triangle, point),
-                            id: b.id,
-                        },
-                        b.origin,
-                        b.weight,
-                    ));
-                } else if !back && material.is_emitter() && self.quantity == Quantity::Radiance {
-                    // An emitter seen along the path; one a glossy lobe's sample reached counts
-                    // with its share against the lights sampled at that lobe.
-                    let mis = match b.lobe_pdf {
-                        Some((pdf, n)) => {
-                            let dist2 = f64::from(hit.t * hit.t * b.ray.dir.length_squared());
-                            let cos_y = -f64::from(dir.dot(tri.normal));
-                            paths
-                                .lights
-                                .lobe_weight(tri.surface, pdf, dist2, cos_y, n, n)
-                        }
-                        None => 1.0,
-                    };
-                    radiance[b.origin] += b.weight * material.ke.as_dvec3() * mis;
-                }
-                if b.depth >= paths.depth || self.quantity != Quantity::Radiance {
-                    continue;
-                }
-                let two_sided = self.scene.surfaces[tri.surface as usize].two_sided;
-                let on = |d: DVec3| {
-                    let n = if d.dot(tri.normal.as_dvec3()) > 0.0 {
-                        tri.normal
-                    } else {
-                        -tri.normal
-                    };
-                    point + lift * n
-                };
-                match branches(material, dir.as_dvec3(), tri.normal.as_dvec3(), two_sided) {
-                    Branches::None => {}
-                    Branches::Delta(list) => {
-                        let heaviest = list
-                            .iter()
-                            .flatten()
-                            .enumerate()
-                            .max_by(|a, b| a.1 .1.max_element().total_cmp(&b.1 .1.max_element()))
-                            .map_or(0, |(k, _)| k);
-                        for (k, (d, w)) in list.iter().flatten().enumerate() {
-                            let weight = b.weight * *w;
-                            if weight.max_element() < NEGLIGIBLE {
-                                continue;
-                            }
-                            next.push(Branch {
-                                ray: Ray {
-                                    origin: on(*d),
-                                    dir: d.as_vec3(),
-                                    t_min: 0.0,
-                                    t_max: f32::INFINITY,
-                                },
-                                origin: b.origin,
-                                weight,
-                                depth: b.depth + 1,
-                                traced: b.traced && b.depth == 0,
-                                glossed: b.glossed,
-                                main: b.main && k == heaviest,
-                                id: side_seed(u64::from(b.id), b.depth, k as u64) as u32,
-                                lobe_pdf: None,
-                            });
-                        }
-                    }
-                    Branches::Glossy(lobe) => {
-                        let from = point + lift * normal;
-                        let mut rng = Pcg64Mcg::seed_from_u64(side_seed(
-                            0x676c_6f73_7379,
-                            b.id,
-                            u64::from(b.depth),
-                        ));
-                        let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
-                        // A fan of directions at the first glossy bounce, one at later ones.
-                        let n = if b.glossed { 1 } else { fan };
-                        self.glossy(n, b, &lobe, from, &mut uniforms, &mut next);
-                        samples.clear();
-                        paths
-                            .lights
-                            .sample(&lobe, from, n, n, &mut uniforms, &mut samples);
-                        shadowed.extend(samples.drain(..).map(|mut sample| {
-                            sample.radiance *= b.weight;
-                            Shadowed {
-                                origin: b.origin,
-                                from,
-                                sample,
-                            }
-                        }));
-                    }
+                match hit {
+                    Some(hit) => self.meet(paths, b, hit, &mut walk, &mut next),
+                    None => self.escape(b, &mut walk),
                 }
             }
             level = next;
         }
-        queries += self.light_samples_seen(paths, &shadowed, &mut radiance)?;
-        let pending: Vec<Pending> = ends.iter().map(|(p, _, _)| p.clone()).collect();
+        queries += self.light_samples_seen(paths, &walk.shadowed, &mut walk.radiance)?;
+        let pending: Vec<Pending> = walk.ends.iter().map(|(p, _, _)| p.clone()).collect();
         let (shown, q) = self.resolve(&pending, 0)?;
         queries += q;
-        for ((_, origin, weight), value) in ends.iter().zip(shown) {
-            radiance[*origin] += *weight * value.as_dvec3();
+        for ((_, origin, weight), value) in walk.ends.iter().zip(shown) {
+            walk.radiance[*origin] += *weight * value.as_dvec3();
         }
-        for ((o, l), side) in out.iter_mut().zip(radiance).zip(sides) {
+        for ((o, l), side) in out.iter_mut().zip(walk.radiance).zip(walk.sides) {
             *o = (l.as_vec3(), side);
         }
         Ok(queries)
+    }
+
+    /// A branch that left the model (through a pane, by a mirror): the sky or the ground, and
+    /// the sun's disc only along delta paths (a glossy lobe's rays are not weighed against the
+    /// sun's).
+    fn escape(&self, b: &Branch, walk: &mut Walk) {
+        let Some(d) = self.scene.daylight() else {
+            return;
+        };
+        if self.quantity == Quantity::Radiance {
+            let sun = if b.lobe_pdf.is_none() {
+                d.sun_radiance(b.ray.dir)
+            } else {
+                0.0
+            };
+            walk.radiance[b.origin] += b.weight * (d.radiance(b.ray.dir) + sun);
+        }
+    }
+
+    /// A branch that met a surface: the side its pixel sample sees (main branches), an end
+    /// where the side has samples or an emitter's light, and the branches that go on.
+    fn meet(
+        &self,
+        paths: &Paths,
+        b: &Branch,
+        hit: &crate::visibility::Hit,
+        walk: &mut Walk,
+        next: &mut Vec<Branch>,
+    ) {
+        let tri = &self.scene.triangles[hit.triangle as usize];
+        let dir = b.ray.dir.normalize();
+        let back = dir.dot(tri.normal) > 0.0;
+        let side = side_of(tri.surface, back);
+        if b.main {
+            // A side id past the scene's sides stands for a path: which side it met at which
+            // depth.
+            walk.sides[b.origin] = if b.depth == 0 {
+                side
+            } else {
+                let n = 2 * self.scene.surfaces.len() as u32;
+                n.wrapping_mul(b.depth).wrapping_add(side)
+            };
+        }
+        let point = b.ray.origin + hit.t * b.ray.dir;
+        let material = self.scene.material_of(tri.surface);
+        let normal = if back { -tri.normal } else { tri.normal };
+        if self.interpolator.has_samples(side) {
+            walk.ends.push((
+                Pending {
+                    side,
+                    fixed: None,
+                    point,
+                    normal,
+                    traced: b.traced,
+                    texel: self.texel(hit.triangle, point),
+                    id: b.id,
+                },
+                b.origin,
+                b.weight,
+            ));
+        } else if !back && material.is_emitter() && self.quantity == Quantity::Radiance {
+            // An emitter seen along the path; one a glossy lobe's sample reached counts with
+            // its share against the lights sampled at that lobe.
+            let mis = match b.lobe_pdf {
+                Some((pdf, n)) => {
+                    let dist2 = f64::from(hit.t * hit.t * b.ray.dir.length_squared());
+                    let cos_y = -f64::from(dir.dot(tri.normal));
+                    paths
+                        .lights
+                        .lobe_weight(tri.surface, pdf, dist2, cos_y, n, n)
+                }
+                None => 1.0,
+            };
+            walk.radiance[b.origin] += b.weight * material.ke.as_dvec3() * mis;
+        }
+        if b.depth >= paths.depth || self.quantity != Quantity::Radiance {
+            return;
+        }
+        let two_sided = self.scene.surfaces[tri.surface as usize].two_sided;
+        match branches(material, dir.as_dvec3(), tri.normal.as_dvec3(), two_sided) {
+            Branches::None => {}
+            Branches::Delta(list) => self.delta_branches(b, tri.normal, point, &list, next),
+            Branches::Glossy(lobe) => {
+                let from = point + self.lift * normal;
+                self.glossy_bounce(paths, b, &lobe, from, walk, next);
+            }
+        }
+    }
+
+    /// A mirror's or glass's branches (the heaviest one goes on as the main branch), each
+    /// leaving from just off the surface (`normal` its plane's) on the side it goes to.
+    fn delta_branches(
+        &self,
+        b: &Branch,
+        normal: Vec3,
+        point: Vec3,
+        list: &[Option<(DVec3, DVec3)>],
+        next: &mut Vec<Branch>,
+    ) {
+        let on = |d: DVec3| {
+            let n = if d.dot(normal.as_dvec3()) > 0.0 {
+                normal
+            } else {
+                -normal
+            };
+            point + self.lift * n
+        };
+        let heaviest = list
+            .iter()
+            .flatten()
+            .enumerate()
+            .max_by(|a, b| a.1 .1.max_element().total_cmp(&b.1 .1.max_element()))
+            .map_or(0, |(k, _)| k);
+        for (k, (d, w)) in list.iter().flatten().enumerate() {
+            let weight = b.weight * *w;
+            if weight.max_element() < NEGLIGIBLE {
+                continue;
+            }
+            next.push(Branch {
+                ray: Ray {
+                    origin: on(*d),
+                    dir: d.as_vec3(),
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                },
+                origin: b.origin,
+                weight,
+                depth: b.depth + 1,
+                traced: b.traced && b.depth == 0,
+                glossed: b.glossed,
+                main: b.main && k == heaviest,
+                id: side_seed(u64::from(b.id), b.depth, k as u64) as u32,
+                lobe_pdf: None,
+            });
+        }
+    }
+
+    /// A glossy bounce at `from`: a fan of directions at the first glossy bounce, one at later
+    /// ones, and as many light samples, their shadow paths kept for the end.
+    fn glossy_bounce(
+        &self,
+        paths: &Paths,
+        b: &Branch,
+        lobe: &Lobe,
+        from: Vec3,
+        walk: &mut Walk,
+        next: &mut Vec<Branch>,
+    ) {
+        let mut rng =
+            Pcg64Mcg::seed_from_u64(side_seed(0x676c_6f73_7379, b.id, u64::from(b.depth)));
+        let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
+        let n = if b.glossed { 1 } else { walk.fan };
+        self.glossy(n, b, lobe, from, &mut uniforms, next);
+        walk.samples.clear();
+        paths
+            .lights
+            .sample(lobe, from, n, n, &mut uniforms, &mut walk.samples);
+        walk.shadowed
+            .extend(walk.samples.drain(..).map(|mut sample| {
+                sample.radiance *= b.weight;
+                Shadowed {
+                    origin: b.origin,
+                    from,
+                    sample,
+                }
+            }));
     }
 
     /// `n` directions drawn from a glossy lobe, each carrying 1/n of the path.

@@ -16,8 +16,9 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::poisson::side_seed;
-use super::{surface_of, Obstruction, Samples, SideIndex, SurfaceMap};
+use super::{surface_of, Layout, Samples};
 use crate::error::Result;
+use crate::exec::Exec;
 use crate::parallel::{for_chunks, Report};
 use crate::progress::Control;
 use crate::visibility::Visibility;
@@ -56,31 +57,24 @@ pub struct RefineSettings {
     pub zeta: f32,
     /// Area weight parameter α (eq. 5), used for eq. 8's weights.
     pub alpha: f32,
-    /// Threads for the errors (the result does not depend on their number).
-    pub threads: usize,
     /// Round number stored in new samples.
     pub round: u16,
-    /// Seed.
-    pub seed: u64,
     /// The total number of samples may not exceed this.
     pub max_samples: usize,
 }
 
 /// Eq. 7's error of every sample, relative to the mean luminance of `radiosity`; NaN where a
-/// sample has no neighbour within 2D that it sees along its side. On up to `threads` threads,
-/// each rank of `ranks` measuring a run of the samples; `None` if `report` answered Stop (on
-/// any rank).
-#[allow(clippy::too_many_arguments)]
-pub fn errors(
+/// sample has no neighbour within 2D that it sees along its side. Each rank measures a run of
+/// the samples; `None` if `report` answered Stop (on any rank).
+pub(crate) fn errors(
     samples: &Samples,
-    maps: &[SurfaceMap],
-    index: &SideIndex,
-    obstruction: &Obstruction,
+    layout: &Layout,
     vis: &dyn Visibility,
     radiosity: &[DVec3],
-    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
+    exec: Exec,
     report: Report,
 ) -> Result<Option<Vec<f64>>> {
+    let (maps, index, obstruction) = (layout.maps(), layout.index(), layout.obstruction());
     let n = samples.len();
     let mean = radiosity.iter().map(|&b| luminance(b)).sum::<f64>() / n.max(1) as f64;
     let mut out = vec![0.0; n];
@@ -111,10 +105,9 @@ pub fn errors(
         Ok(())
     };
     let all = crate::distributed::for_share(
-        ranks,
+        exec,
         &mut out,
         1024,
-        threads,
         error,
         report,
         // Across ranks "no neighbour" travels as −1: a transport carries finite numbers
@@ -131,29 +124,20 @@ pub fn errors(
 /// Refines where the error exceeds ζ: shrinks those samples' radii and adds new samples
 /// around them (appended to `samples`, area 0). The index must describe `samples` as given.
 /// `report` hears the share of the errors computed now and then.
-#[allow(clippy::too_many_arguments)]
-pub fn refine(
+pub(crate) fn refine(
     samples: &mut Samples,
-    maps: &[SurfaceMap],
-    index: &SideIndex,
-    obstruction: &Obstruction,
+    layout: &Layout,
     vis: &dyn Visibility,
     radiosity: &[DVec3],
     settings: RefineSettings,
-    ranks: &dyn crate::distributed::Ranks,
+    exec: Exec,
     report: Report,
 ) -> Result<Refinement> {
+    let (maps, index, ranks) = (layout.maps(), layout.index(), exec.ranks);
     // The errors take the first half of the phase's share, the darts the second.
-    let Some(errors) = errors(
-        samples,
-        maps,
-        index,
-        obstruction,
-        vis,
-        radiosity,
-        (settings.threads, ranks),
-        &mut |f| report(0.5 * f),
-    )?
+    let Some(errors) = errors(samples, layout, vis, radiosity, exec, &mut |f| {
+        report(0.5 * f)
+    })?
     else {
         // Told to stop: nothing added.
         return Ok(Refinement::default());
@@ -231,7 +215,7 @@ pub fn refine(
             break;
         }
         let mut work: Vec<(usize, &mut Vec<(Vec2, f32)>)> = placed.iter_mut().enumerate().collect();
-        for_chunks(&mut work, 1, settings.threads, |_, out| {
+        for_chunks(&mut work, 1, exec.threads, |_, out| {
             let (g, points) = &mut out[0];
             if !crate::distributed::deals(ranks, *g) {
                 // Another rank's side.
@@ -239,7 +223,7 @@ pub fn refine(
             }
             let piece = &discs[pieces[*g].clone()];
             if !piece.is_empty() {
-                fill_discs(shared, maps, index, piece, settings, old, points);
+                fill_discs(shared, layout, piece, settings, exec.seed, old, points);
             }
             Ok(())
         })?;
@@ -295,13 +279,14 @@ pub fn refine(
 /// the number of samples before this refinement.
 fn fill_discs(
     samples: &Samples,
-    maps: &[SurfaceMap],
-    index: &SideIndex,
+    layout: &Layout,
     discs: &[(usize, f32, u32)],
     settings: RefineSettings,
+    seed: u64,
     old: usize,
     out: &mut Vec<(Vec2, f32)>,
 ) {
+    let (maps, index) = (layout.maps(), layout.index());
     let eps = settings.epsilon;
     let min_radius = eps / MAX_SPLIT;
     let cell = eps / 2.0;
@@ -317,11 +302,8 @@ fn fill_discs(
         let side = samples.side[k];
         let map = &maps[surface_of(side) as usize];
         let centre = samples.uv[k];
-        let mut rng = Pcg64Mcg::seed_from_u64(side_seed(
-            settings.seed,
-            k as u32,
-            3 + u64::from(settings.round),
-        ));
+        let mut rng =
+            Pcg64Mcg::seed_from_u64(side_seed(seed, k as u32, 3 + u64::from(settings.round)));
         for _ in 0..m * DARTS_PER_SAMPLE {
             // Uniform in the old disc.
             let angle = rng.random::<f32>() * std::f32::consts::TAU;

@@ -4,6 +4,7 @@
 
 pub mod adaptive;
 pub(crate) mod cover;
+mod layout;
 pub mod obstruction;
 pub mod poisson;
 pub(crate) mod reflectance;
@@ -14,6 +15,7 @@ pub(crate) mod triangles;
 use glam::{Vec2, Vec3};
 
 use crate::scene::Scene;
+pub(crate) use layout::Layout;
 pub use obstruction::Obstruction;
 pub(crate) use shares::Shares;
 pub use surface_map::SurfaceMap;

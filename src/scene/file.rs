@@ -301,143 +301,20 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
     let at = |span: Range<usize>, problem: String| {
         Error::scene(path, Some(line_of(text, span.start)), problem)
     };
-
-    let camera = match parsed.camera {
-        None => None,
-        Some(c) => {
-            let camera_span = c.span();
-            let c = c.into_inner();
-            let camera = Camera {
-                position: Vec3::from(c.position),
-                look_at: Vec3::from(c.look_at),
-                up: Vec3::from(c.up.unwrap_or([0.0, 1.0, 0.0])),
-                fov_y: c.fov_y,
-                width: c.width,
-                height: c.height,
-            };
-            if let Some(problem) = camera.problem() {
-                return Err(at(camera_span, problem));
-            }
-            Some(camera)
-        }
-    };
-
-    let mut point_lights = Vec::with_capacity(parsed.point_light.len());
-    for light in parsed.point_light {
-        let span = light.span();
-        let l = light.into_inner();
-        let light = PointLight {
-            position: Vec3::from(l.position),
-            intensity: Vec3::from(l.intensity),
-        };
-        if let Some(problem) = validate::point_light(&light) {
-            return Err(at(span, problem));
-        }
-        point_lights.push(light);
-    }
-
     let dir = path.parent().unwrap_or(Path::new(""));
+    let camera = parsed.camera.map(|c| camera(c, &at)).transpose()?;
+    let point_lights = point_lights(parsed.point_light, &at)?;
     let mut luminaires = Vec::with_capacity(parsed.luminaire.len());
     for l in parsed.luminaire {
         let span = l.span();
         let fail = |problem: String| at(span.clone(), problem);
         luminaires.push(luminaire(files, dir, l.into_inner(), &fail)?);
     }
-    let mut grids: Vec<Grid> = Vec::with_capacity(parsed.grid.len());
-    for g in parsed.grid {
-        let span = g.span();
-        let fail = |problem: String| at(span.clone(), problem);
-        let g = grid(g.into_inner(), &fail)?;
-        if grids.iter().any(|other| other.name == g.name) {
-            return Err(fail(format!("grid '{}': name used twice", g.name)));
-        }
-        grids.push(g);
-    }
-    let units = match parsed.units {
-        None => Units::Radiometric,
-        Some(u) => match u.get_ref().as_str() {
-            "radiometric" => Units::Radiometric,
-            "photometric" => Units::Photometric,
-            other => {
-                return Err(at(
-                    u.span(),
-                    format!("units = \"{other}\": either \"radiometric\" or \"photometric\""),
-                ))
-            }
-        },
-    };
-
-    let mut solver = SolverDefaults::default();
-    if let Some(s) = parsed.solver {
-        let span = s.span();
-        let s = s.into_inner();
-        if let Some(problem) = s.epsilon.and_then(validate::epsilon) {
-            return Err(at(span, format!("[solver] {problem}")));
-        }
-        solver.epsilon = s.epsilon;
-        if let Some(problem) = s.max_reflectance.and_then(validate::max_reflectance) {
-            return Err(at(span, format!("[solver] {problem}")));
-        }
-        solver.max_reflectance = s.max_reflectance;
-    }
-
-    let (site_span, site) = match parsed.site {
-        Some(s) => {
-            let span = s.span();
-            (Some(span.clone()), Some(site(s.into_inner(), span, &at)?))
-        }
-        None => (None, None),
-    };
-    if let (Some(span), None, None) = (&site_span, &parsed.sky, &parsed.annual) {
-        return Err(at(
-            span.clone(),
-            "[site] without a [sky] or an [annual]: give the sky (model = \"cie-overcast\", \
-             say)"
-                .into(),
-        ));
-    }
-    let site_fail = |problem: String, fallback: &Range<usize>| match &site_span {
-        Some(span) => at(span.clone(), format!("[site] {problem}")),
-        None => at(fallback.clone(), problem),
-    };
-    let daylight = match parsed.sky {
-        Some(sky) => Some(daylight(site.as_ref(), sky, &at, &site_fail)?),
-        None => None,
-    };
-    let annual = match parsed.annual {
-        Some(a) => {
-            let span = a.span();
-            Some(annual(dir, site, a.into_inner(), &|p| {
-                at(span.clone(), format!("[annual] {p}"))
-            })?)
-        }
-        None => None,
-    };
-
-    let line = |span: Range<usize>| line_of(text, span.start);
-    let rgb = |v: Spanned<[f32; 3]>| (Vec3::from(*v.get_ref()), line(v.span()));
-    let overrides = parsed
-        .material
-        .into_iter()
-        .map(|(name, table)| {
-            let table_line = line(table.span());
-            let m = table.into_inner();
-            Override {
-                name,
-                line: table_line,
-                kind: m.kind.map(|k| (k.get_ref().clone(), line(k.span()))),
-                kd: m.kd.map(rgb),
-                ks: m.ks.map(rgb),
-                roughness: m.roughness.map(|r| (*r.get_ref(), line(r.span()))),
-                ior: m.ior.map(|r| (*r.get_ref(), line(r.span()))),
-                transmit: m.transmit.map(rgb),
-                thin: m.thin.map(|b| (*b.get_ref(), line(b.span()))),
-                ke: m.ke.map(rgb),
-                two_sided: m.two_sided.map(|b| (*b.get_ref(), line(b.span()))),
-            }
-        })
-        .collect();
-
+    let grids = grids(parsed.grid, &at)?;
+    let units = units(parsed.units, &at)?;
+    let solver = solver_defaults(parsed.solver, &at)?;
+    let (daylight, annual) = sky_and_year(dir, parsed.site, parsed.sky, parsed.annual, &at)?;
+    let overrides = overrides(parsed.material, text);
     let (key, named) = match (parsed.obj, parsed.gltf) {
         (Some(obj), None) => ("obj", obj),
         (None, Some(gltf)) => ("gltf", gltf),
@@ -470,16 +347,6 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
             "the scene has no [camera] (an OBJ carries none)",
         ));
     }
-    let name = Path::new(&obj).file_name().map(|n| n.to_string_lossy());
-    let obj_notes = name
-        .map(|name| {
-            let comments = text.lines().filter_map(|l| l.trim().strip_prefix('#'));
-            comments
-                .filter(|c| c.contains(name.as_ref()))
-                .map(|c| c.trim().to_string())
-                .collect()
-        })
-        .unwrap_or_default();
     Ok(SceneFile {
         geometry: if key == "obj" {
             Geometry::Obj(dir.join(&obj))
@@ -495,10 +362,184 @@ pub(super) fn read(files: &dyn super::Source, path: &Path) -> Result<SceneFile> 
         solver,
         overrides,
         obj_line: line_of(text, obj_span.start),
-        obj_notes,
+        obj_notes: notes_naming(text, &obj),
         daylight,
         annual,
     })
+}
+
+/// Where in the scene file a problem is: (span, problem) to an error naming its line.
+type At<'a> = dyn Fn(Range<usize>, String) -> Error + 'a;
+
+/// `[camera]`, checked as a host's camera is.
+fn camera(c: Spanned<CameraToml>, at: &At) -> Result<Camera> {
+    let camera_span = c.span();
+    let c = c.into_inner();
+    let camera = Camera {
+        position: Vec3::from(c.position),
+        look_at: Vec3::from(c.look_at),
+        up: Vec3::from(c.up.unwrap_or([0.0, 1.0, 0.0])),
+        fov_y: c.fov_y,
+        width: c.width,
+        height: c.height,
+    };
+    match camera.problem() {
+        Some(problem) => Err(at(camera_span, problem)),
+        None => Ok(camera),
+    }
+}
+
+/// `[[point_light]]`, each checked as a host's light is.
+fn point_lights(lights: Vec<Spanned<PointLightToml>>, at: &At) -> Result<Vec<PointLight>> {
+    let mut point_lights = Vec::with_capacity(lights.len());
+    for light in lights {
+        let span = light.span();
+        let l = light.into_inner();
+        let light = PointLight {
+            position: Vec3::from(l.position),
+            intensity: Vec3::from(l.intensity),
+        };
+        if let Some(problem) = validate::point_light(&light) {
+            return Err(at(span, problem));
+        }
+        point_lights.push(light);
+    }
+    Ok(point_lights)
+}
+
+/// `[[grid]]`, each name once.
+fn grids(tables: Vec<Spanned<GridToml>>, at: &At) -> Result<Vec<Grid>> {
+    let mut grids: Vec<Grid> = Vec::with_capacity(tables.len());
+    for g in tables {
+        let span = g.span();
+        let fail = |problem: String| at(span.clone(), problem);
+        let g = grid(g.into_inner(), &fail)?;
+        if grids.iter().any(|other| other.name == g.name) {
+            return Err(fail(format!("grid '{}': name used twice", g.name)));
+        }
+        grids.push(g);
+    }
+    Ok(grids)
+}
+
+/// `units`: radiometric unless it says photometric.
+fn units(units: Option<Spanned<String>>, at: &At) -> Result<Units> {
+    match units {
+        None => Ok(Units::Radiometric),
+        Some(u) => match u.get_ref().as_str() {
+            "radiometric" => Ok(Units::Radiometric),
+            "photometric" => Ok(Units::Photometric),
+            other => Err(at(
+                u.span(),
+                format!("units = \"{other}\": either \"radiometric\" or \"photometric\""),
+            )),
+        },
+    }
+}
+
+/// `[solver]`: the scene's own ε and max_reflectance, checked.
+fn solver_defaults(table: Option<Spanned<SolverToml>>, at: &At) -> Result<SolverDefaults> {
+    let mut solver = SolverDefaults::default();
+    if let Some(s) = table {
+        let span = s.span();
+        let s = s.into_inner();
+        if let Some(problem) = s.epsilon.and_then(validate::epsilon) {
+            return Err(at(span, format!("[solver] {problem}")));
+        }
+        solver.epsilon = s.epsilon;
+        if let Some(problem) = s.max_reflectance.and_then(validate::max_reflectance) {
+            return Err(at(span, format!("[solver] {problem}")));
+        }
+        solver.max_reflectance = s.max_reflectance;
+    }
+    Ok(solver)
+}
+
+/// `[site]`, `[sky]` and `[annual]`: the daylight of one moment and the year's settings. A
+/// site needs a sky or a year to light.
+fn sky_and_year(
+    dir: &Path,
+    site_table: Option<Spanned<SiteToml>>,
+    sky: Option<Spanned<SkyToml>>,
+    year: Option<Spanned<AnnualToml>>,
+    at: &At,
+) -> Result<(Option<Daylight>, Option<crate::daylight::AnnualSettings>)> {
+    let (site_span, site) = match site_table {
+        Some(s) => {
+            let span = s.span();
+            (Some(span.clone()), Some(site(s.into_inner(), span, at)?))
+        }
+        None => (None, None),
+    };
+    if let (Some(span), None, None) = (&site_span, &sky, &year) {
+        return Err(at(
+            span.clone(),
+            "[site] without a [sky] or an [annual]: give the sky (model = \"cie-overcast\", \
+             say)"
+                .into(),
+        ));
+    }
+    let site_fail = |problem: String, fallback: &Range<usize>| match &site_span {
+        Some(span) => at(span.clone(), format!("[site] {problem}")),
+        None => at(fallback.clone(), problem),
+    };
+    let daylight = match sky {
+        Some(sky) => Some(daylight(site.as_ref(), sky, at, &site_fail)?),
+        None => None,
+    };
+    let annual = match year {
+        Some(a) => {
+            let span = a.span();
+            Some(annual(dir, site, a.into_inner(), &|p| {
+                at(span.clone(), format!("[annual] {p}"))
+            })?)
+        }
+        None => None,
+    };
+    Ok((daylight, annual))
+}
+
+/// `[material.NAME]` tables, each key with its line in `text`.
+fn overrides(
+    tables: std::collections::BTreeMap<String, Spanned<MaterialToml>>,
+    text: &str,
+) -> Vec<Override> {
+    let line = |span: Range<usize>| line_of(text, span.start);
+    let rgb = |v: Spanned<[f32; 3]>| (Vec3::from(*v.get_ref()), line(v.span()));
+    tables
+        .into_iter()
+        .map(|(name, table)| {
+            let table_line = line(table.span());
+            let m = table.into_inner();
+            Override {
+                name,
+                line: table_line,
+                kind: m.kind.map(|k| (k.get_ref().clone(), line(k.span()))),
+                kd: m.kd.map(rgb),
+                ks: m.ks.map(rgb),
+                roughness: m.roughness.map(|r| (*r.get_ref(), line(r.span()))),
+                ior: m.ior.map(|r| (*r.get_ref(), line(r.span()))),
+                transmit: m.transmit.map(rgb),
+                thin: m.thin.map(|b| (*b.get_ref(), line(b.span()))),
+                ke: m.ke.map(rgb),
+                two_sided: m.two_sided.map(|b| (*b.get_ref(), line(b.span()))),
+            }
+        })
+        .collect()
+}
+
+/// The scene file's comments that name the geometry file (`geometry`'s file name): the notes
+/// a summary repeats (where the export came from, say).
+fn notes_naming(text: &str, geometry: &str) -> Vec<String> {
+    let name = Path::new(geometry).file_name().map(|n| n.to_string_lossy());
+    name.map(|name| {
+        let comments = text.lines().filter_map(|l| l.trim().strip_prefix('#'));
+        comments
+            .filter(|c| c.contains(name.as_ref()))
+            .map(|c| c.trim().to_string())
+            .collect()
+    })
+    .unwrap_or_default()
 }
 
 /// `"YYYY-MM-DDTHH:MM"` (or with `:SS`) as a local standard time in `timezone`.

@@ -13,6 +13,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
 
+use super::mtl::Rules;
 use super::{Camera, Kind, Luminaire, Material, Mesh, PointLight, Texture, Units};
 use crate::error::{Error, Result};
 
@@ -36,13 +37,13 @@ const MAX_NODE_VISITS: usize = 1_000_000;
 /// Triangles a file's meshes may unfold into, instances counted.
 const MAX_TRIANGLES: usize = 50_000_000;
 
-/// Reads `path` (a `.gltf` or `.glb`); `units` decides how lights come across, `max_reflectance`
-/// and `strict` how a white base colour is treated, as for MTL files.
+/// Reads `path` (a `.gltf` or `.glb`); `units` decides how lights come across, `rules` how a
+/// white base colour is treated, as for MTL files.
 pub(super) fn read(
     files: &dyn super::Source,
     path: &Path,
     units: Units,
-    (max_reflectance, strict): (f32, bool),
+    rules: &Rules,
 ) -> Result<GltfScene> {
     let fail = |problem: String| Error::scene(path, None, problem);
     let bytes = files.read(path).map_err(|cause| Error::Read {
@@ -53,344 +54,458 @@ pub(super) fn read(
         .map_err(|e| fail(format!("not a glTF 2.0 file meshlight can read: {e}")))?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = buffers(files, base, &gltf).map_err(fail)?;
-    let document = &gltf.document;
-    let mut out = GltfScene {
-        mesh: Mesh::default(),
-        cameras: Vec::new(),
-        point_lights: Vec::new(),
-        luminaires: Vec::new(),
+    let mut file = File {
+        files,
+        path,
+        base,
+        document: &gltf.document,
+        buffers: &buffers,
+        rules,
+        photometric: units == Units::Photometric,
+        falloff: Falloff::of(&gltf.document),
         warnings: Vec::new(),
     };
-    let mut warn = |w: String| out.warnings.push(format!("{}: {w}", path.display()));
-    // Decision: a spot fades as the tool that wrote the file showed it, where we know that
-    // tool: Blender's files as Cycles draws them (with the specification's falloff a Blender
-    // spot's room came out 26% darker than in Cycles), others as glTF recommends.
-    let falloff = match document.as_json().asset.generator.as_deref() {
-        Some(g) if g.starts_with("Khronos glTF Blender") => Falloff::Cycles,
-        _ => Falloff::Gltf,
+    let (materials, texcoord_sets) = file.materials()?;
+    let mut found = Found {
+        out: GltfScene {
+            mesh: Mesh::default(),
+            cameras: Vec::new(),
+            point_lights: Vec::new(),
+            luminaires: Vec::new(),
+            warnings: Vec::new(),
+        },
+        default_material: materials.len() as u32,
+        used_default: false,
+        texcoord_sets,
     };
-    let photometric = units == Units::Photometric;
-
-    // Materials in file order; one more for primitives without a material. Each material's
-    // base colour texture coordinate set, where it has a texture that could be read.
-    let mut materials = Vec::new();
-    let mut texcoord_sets: Vec<Option<u32>> = Vec::new();
-    let mut images: HashMap<usize, Option<Arc<Texture>>> = HashMap::new();
-    for m in document.materials() {
-        let info = m.pbr_metallic_roughness().base_color_texture();
-        let texture = info.as_ref().and_then(|info| {
-            let image = info.texture().source();
-            images
-                .entry(image.index())
-                .or_insert_with(|| {
-                    let read = texture(files, (document, base), &buffers, &image, max_reflectance);
-                    read.map_err(|problem| {
-                        warn(format!(
-                            "material {}: its base colour texture (image {}) cannot be read \
-                             ({problem}): the base colour factor is used",
-                            m.name().map_or_else(
-                                || m.index().unwrap_or(0).to_string(),
-                                |n| format!("'{n}'")
-                            ),
-                            image.index()
-                        ))
-                    })
-                    .ok()
-                    .map(Arc::new)
-                })
-                .clone()
-        });
-        let mut material = material(
-            &m,
-            photometric,
-            (max_reflectance, strict),
-            texture.is_some(),
-            &mut warn,
-        )
-        .map_err(fail)?;
-        if let (Some(info), Some(texture)) = (&info, texture) {
-            if info.texture().sampler().wrap_s() != gltf::texture::WrappingMode::Repeat
-                || info.texture().sampler().wrap_t() != gltf::texture::WrappingMode::Repeat
-            {
-                warn(format!(
-                    "material '{}': its texture's clamped or mirrored wrapping is read as repeat",
-                    material.name
-                ));
-            }
-            material.texture = Some(texture);
-            texcoord_sets.push(Some(info.tex_coord()));
-        } else {
-            texcoord_sets.push(None);
-        }
-        if let Some((_, problem)) = super::validate::material_field(&material) {
-            return Err(fail(problem));
-        }
-        materials.push(material);
-    }
-    let default_material = materials.len() as u32;
-    let mut used_default = false;
-
-    let Some(scene) = document
-        .default_scene()
-        .or_else(|| document.scenes().next())
-    else {
-        return Err(fail("it has no scene".into()));
-    };
-    // Depth first, with the path from the root: a node among its own ancestors is a cycle (the
-    // walk would never end). A node reached again by another way is an instance, as many times
-    // as the file says, up to MAX_NODE_VISITS.
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> =
-        scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
-    stack.reverse();
-    let mut path_from_root: Vec<usize> = Vec::new();
-    let mut visits = 0usize;
-    while let Some((node, parent, depth)) = stack.pop() {
-        path_from_root.truncate(depth);
-        if path_from_root.contains(&node.index()) {
-            return Err(fail(format!(
-                "node {} is its own ancestor (through nodes {:?}): the node graph has a cycle",
-                node.index(),
-                path_from_root
-            )));
-        }
-        path_from_root.push(node.index());
-        visits += 1;
-        if visits > MAX_NODE_VISITS || out.mesh.triangles.len() > MAX_TRIANGLES {
-            return Err(fail(format!(
-                "its nodes, instanced as the file asks, make more than {} nodes or {} \
-                 triangles: refused",
-                crate::budget::human_count(MAX_NODE_VISITS as f64),
-                crate::budget::human_count(MAX_TRIANGLES as f64)
-            )));
-        }
-        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
-        let world = parent * local;
-        if !world.is_finite() {
-            return Err(fail(format!(
-                "node {} has a transform that is not finite",
-                node.index()
-            )));
-        }
-        if let Some(mesh) = node.mesh() {
-            let mirrored = world.determinant() < 0.0;
-            for prim in mesh.primitives() {
-                if prim.mode() != gltf::mesh::Mode::Triangles {
-                    warn(format!(
-                        "mesh {} has a primitive of mode {:?}: only triangles are read",
-                        mesh.index(),
-                        prim.mode()
-                    ));
-                    continue;
-                }
-                // The gltf crate's readers trust accessors (a count of 0 or a stride below the
-                // element size underflows in them): each one used is checked first.
-                use gltf::accessor::{DataType as T, Dimensions as D};
-                let read = prim
-                    .attributes()
-                    .filter_map(|(semantic, a)| match semantic {
-                        gltf::Semantic::Positions => Some((a, &[T::F32][..], D::Vec3)),
-                        gltf::Semantic::TexCoords(_) => {
-                            Some((a, &[T::F32, T::U8, T::U16][..], D::Vec2))
-                        }
-                        _ => None,
-                    });
-                let indices = prim
-                    .indices()
-                    .map(|a| (a, &[T::U8, T::U16, T::U32][..], D::Scalar));
-                for (accessor, types, dimensions) in read.chain(indices) {
-                    let typed = types.contains(&accessor.data_type())
-                        && accessor.dimensions() == dimensions;
-                    let fits = if typed {
-                        accessor_fits(&accessor, &buffers)
-                    } else {
-                        Err(format!(
-                            "{:?} {:?} elements where glTF allows {types:?} {dimensions:?}",
-                            accessor.data_type(),
-                            accessor.dimensions()
-                        ))
-                    };
-                    fits.map_err(|problem| {
-                        fail(format!(
-                            "mesh {}: accessor {}: {problem}",
-                            mesh.index(),
-                            accessor.index()
-                        ))
-                    })?;
-                }
-                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-                let Some(positions) = reader.read_positions() else {
-                    warn(format!(
-                        "mesh {} has a primitive without positions",
-                        mesh.index()
-                    ));
-                    continue;
-                };
-                let first = out.mesh.positions.len() as u32;
-                out.mesh
-                    .positions
-                    .extend(positions.map(|p| world.transform_point3(Vec3::from(p))));
-                let count = out.mesh.positions.len() as u32 - first;
-                let indices: Vec<u32> = match reader.read_indices() {
-                    Some(i) => i.into_u32().collect(),
-                    None => (0..count).collect(),
-                };
-                if let Some(bad) = indices.iter().find(|&&i| i >= count) {
-                    return Err(fail(format!(
-                        "mesh {} indexes vertex {bad} of {count}",
-                        mesh.index()
-                    )));
-                }
-                let m = match prim.material().index() {
-                    Some(i) => i as u32,
-                    None => {
-                        used_default = true;
-                        default_material
-                    }
-                };
-                let set = texcoord_sets.get(m as usize).copied().flatten();
-                let uv: Option<Vec<Vec2>> = set
-                    .and_then(|set| reader.read_tex_coords(set))
-                    .map(|tc| tc.into_f32().map(Vec2::from).collect())
-                    .filter(|uv: &Vec<Vec2>| {
-                        uv.len() == count as usize && uv.iter().all(|c| c.is_finite())
-                    });
-                if set.is_some() && uv.is_none() {
-                    warn(format!(
-                        "mesh {} has a textured primitive without usable texture coordinates: \
-                         it shows the base colour factor",
-                        mesh.index()
-                    ));
-                }
-                if let Some(uv) = &uv {
-                    out.mesh.texcoords.resize(out.mesh.triangles.len(), None);
-                    for t in indices.chunks_exact(3) {
-                        let corner = |i: usize| uv[t[i] as usize];
-                        let c = if mirrored {
-                            [corner(0), corner(2), corner(1)]
-                        } else {
-                            [corner(0), corner(1), corner(2)]
-                        };
-                        out.mesh.texcoords.push(Some(c));
-                    }
-                } else if !out.mesh.texcoords.is_empty() {
-                    let n = out.mesh.triangles.len() + indices.len() / 3;
-                    out.mesh.texcoords.resize(n, None);
-                }
-                for t in indices.chunks_exact(3) {
-                    let t = [first + t[0], first + t[1], first + t[2]];
-                    out.mesh
-                        .triangles
-                        .push(if mirrored { [t[0], t[2], t[1]] } else { t });
-                    out.mesh.triangle_materials.push(m);
-                }
-            }
-        }
-        if let Some(camera) = node.camera() {
-            match camera.projection() {
-                gltf::camera::Projection::Perspective(p) => {
-                    let position = world.transform_point3(Vec3::ZERO);
-                    let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
-                    let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-                    let aspect = p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0);
-                    let width = 512u32;
-                    let height = aspect.map_or(512, |a| ((512.0 / a).round() as u32).max(1));
-                    // The node's name is what a modelling tool shows (Blender's object name).
-                    let name = node
-                        .name()
-                        .or(camera.name())
-                        .map_or_else(|| format!("camera {}", camera.index()), str::to_string);
-                    let camera = Camera {
-                        position,
-                        look_at: position + forward,
-                        up,
-                        fov_y: p.yfov().to_degrees(),
-                        width,
-                        height,
-                    };
-                    // The checks a host's camera gets (`Scene::set_camera`).
-                    if let Some(problem) = camera.problem() {
-                        return Err(fail(format!("camera '{name}': {problem}")));
-                    }
-                    out.cameras.push((name, camera));
-                }
-                gltf::camera::Projection::Orthographic(_) => warn(format!(
-                    "camera {} is orthographic: only perspective cameras are read",
-                    camera.index()
-                )),
-            }
-        }
-        if let Some(light) = node.light() {
-            let colour = Vec3::from(light.color());
-            let candela = colour * light.intensity();
-            let intensity = if photometric {
-                candela
-            } else {
-                candela / EFFICACY
-            };
-            // The checks a host's point light gets: finite, not negative.
-            let point = PointLight {
-                position: world.transform_point3(Vec3::ZERO),
-                intensity,
-            };
-            if let Some(problem) = super::validate::point_light(&point) {
-                return Err(fail(format!(
-                    "light {} (intensity {}, colour {:?}): {problem}",
-                    light.index(),
-                    light.intensity(),
-                    light.color()
-                )));
-            }
-            match light.kind() {
-                gltf::khr_lights_punctual::Kind::Point => {
-                    out.point_lights.push(point);
-                }
-                gltf::khr_lights_punctual::Kind::Spot {
-                    inner_cone_angle,
-                    outer_cone_angle,
-                } => {
-                    let aim = world.transform_vector3(-Vec3::Z).normalize_or_zero();
-                    if aim == Vec3::ZERO {
-                        warn(format!(
-                            "light {} is a spot whose node points nowhere: left out",
-                            light.index()
-                        ));
-                    } else {
-                        out.luminaires.push(Luminaire {
-                            position: world.transform_point3(Vec3::ZERO),
-                            aim,
-                            c0: aim.any_orthonormal_vector(),
-                            tint: intensity,
-                            photometry: Arc::new(spot_cone(
-                                inner_cone_angle,
-                                outer_cone_angle,
-                                falloff,
-                            )),
-                        });
-                    }
-                }
-                gltf::khr_lights_punctual::Kind::Directional => warn(format!(
-                    "light {} is a directional light: only point and spot lights are read",
-                    light.index()
-                )),
-            }
-        }
-        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
-            stack.push((child, world, depth + 1));
-        }
-    }
+    file.walk(&mut found)?;
+    let mut out = found.out;
     if out.mesh.triangles.is_empty() {
         return Err(fail("its scene has no triangles".into()));
     }
-    if used_default {
-        warn("faces without a material get a grey diffuse one (Kd 0.8)".into());
+    if found.used_default {
+        file.warn("faces without a material get a grey diffuse one (Kd 0.8)".into());
     }
-    materials.push(Material::diffuse(
+    out.mesh.materials = materials;
+    out.mesh.materials.push(Material::diffuse(
         "(no material)",
         Vec3::splat(0.8),
         Vec3::ZERO,
     ));
-    out.mesh.materials = materials;
+    out.warnings = file.warnings;
     Ok(out)
+}
+
+/// A glTF file being read, and what reading it needs.
+struct File<'a> {
+    files: &'a dyn super::Source,
+    path: &'a Path,
+    /// The folder the file's own files (buffers, images) are named from.
+    base: &'a Path,
+    document: &'a gltf::Document,
+    buffers: &'a [gltf::buffer::Data],
+    rules: &'a Rules,
+    photometric: bool,
+    falloff: Falloff,
+    warnings: Vec<String>,
+}
+
+/// What the walk of the node graph has found so far.
+struct Found {
+    out: GltfScene,
+    /// The material of primitives without one (after the file's own).
+    default_material: u32,
+    used_default: bool,
+    /// Per material: the texture coordinate set of its base colour texture, where it has one
+    /// that could be read.
+    texcoord_sets: Vec<Option<u32>>,
+}
+
+impl File<'_> {
+    fn warn(&mut self, w: String) {
+        self.warnings.push(format!("{}: {w}", self.path.display()));
+    }
+
+    fn fail(&self, problem: String) -> Error {
+        Error::scene(self.path, None, problem)
+    }
+
+    /// The materials in file order, and each one's base colour texture coordinate set.
+    fn materials(&mut self) -> Result<(Vec<Material>, Vec<Option<u32>>)> {
+        let mut materials = Vec::new();
+        let mut texcoord_sets: Vec<Option<u32>> = Vec::new();
+        let mut images: HashMap<usize, Option<Arc<Texture>>> = HashMap::new();
+        for m in self.document.materials() {
+            let info = m.pbr_metallic_roughness().base_color_texture();
+            let texture = match &info {
+                Some(info) => self.base_colour_texture(&m, &info.texture().source(), &mut images),
+                None => None,
+            };
+            let mut warnings = Vec::new();
+            let mut material = material(
+                &m,
+                self.photometric,
+                self.rules,
+                texture.is_some(),
+                &mut |w| warnings.push(w),
+            )
+            .map_err(|problem| self.fail(problem))?;
+            warnings.into_iter().for_each(|w| self.warn(w));
+            if let (Some(info), Some(texture)) = (&info, texture) {
+                let sampler = info.texture().sampler();
+                if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
+                    || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
+                {
+                    self.warn(format!(
+                        "material '{}': its texture's clamped or mirrored wrapping is read as \
+                         repeat",
+                        material.name
+                    ));
+                }
+                material.texture = Some(texture);
+                texcoord_sets.push(Some(info.tex_coord()));
+            } else {
+                texcoord_sets.push(None);
+            }
+            if let Some((_, problem)) = super::validate::material_field(&material) {
+                return Err(self.fail(problem));
+            }
+            materials.push(material);
+        }
+        Ok((materials, texcoord_sets))
+    }
+
+    /// Material `m`'s base colour texture `image`, read once per image (`images`); none, with
+    /// a warning, where it cannot be read.
+    fn base_colour_texture(
+        &mut self,
+        m: &gltf::Material,
+        image: &gltf::Image,
+        images: &mut HashMap<usize, Option<Arc<Texture>>>,
+    ) -> Option<Arc<Texture>> {
+        if let Some(known) = images.get(&image.index()) {
+            return known.clone();
+        }
+        let read = texture(
+            self.files,
+            (self.document, self.base),
+            self.buffers,
+            image,
+            self.rules.max_reflectance,
+        );
+        let texture = match read {
+            Ok(texture) => Some(Arc::new(texture)),
+            Err(problem) => {
+                self.warn(format!(
+                    "material {}: its base colour texture (image {}) cannot be read \
+                     ({problem}): the base colour factor is used",
+                    m.name()
+                        .map_or_else(|| m.index().unwrap_or(0).to_string(), |n| format!("'{n}'")),
+                    image.index()
+                ));
+                None
+            }
+        };
+        images.insert(image.index(), texture.clone());
+        texture
+    }
+
+    /// Walks the default scene's node graph (else the first scene's), depth first with the
+    /// path from the root: a node among its own ancestors is a cycle (the walk would never
+    /// end). A node reached again by another way is an instance, as many times as the file
+    /// says, up to MAX_NODE_VISITS.
+    fn walk(&mut self, found: &mut Found) -> Result<()> {
+        let document = self.document;
+        let Some(scene) = document
+            .default_scene()
+            .or_else(|| document.scenes().next())
+        else {
+            return Err(self.fail("it has no scene".into()));
+        };
+        let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+            scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+        stack.reverse();
+        let mut path_from_root: Vec<usize> = Vec::new();
+        let mut visits = 0usize;
+        while let Some((node, parent, depth)) = stack.pop() {
+            path_from_root.truncate(depth);
+            if path_from_root.contains(&node.index()) {
+                return Err(self.fail(format!(
+                    "node {} is its own ancestor (through nodes {:?}): the node graph has a cycle",
+                    node.index(),
+                    path_from_root
+                )));
+            }
+            path_from_root.push(node.index());
+            visits += 1;
+            if visits > MAX_NODE_VISITS || found.out.mesh.triangles.len() > MAX_TRIANGLES {
+                return Err(self.fail(format!(
+                    "its nodes, instanced as the file asks, make more than {} nodes or {} \
+                     triangles: refused",
+                    crate::budget::human_count(MAX_NODE_VISITS as f64),
+                    crate::budget::human_count(MAX_TRIANGLES as f64)
+                )));
+            }
+            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            let world = parent * local;
+            if !world.is_finite() {
+                return Err(self.fail(format!(
+                    "node {} has a transform that is not finite",
+                    node.index()
+                )));
+            }
+            if let Some(mesh) = node.mesh() {
+                for prim in mesh.primitives() {
+                    self.primitive(&mesh, &prim, world, found)?;
+                }
+            }
+            if let Some(camera) = node.camera() {
+                self.camera(&node, &camera, world, &mut found.out)?;
+            }
+            if let Some(light) = node.light() {
+                self.light(&light, world, &mut found.out)?;
+            }
+            for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+                stack.push((child, world, depth + 1));
+            }
+        }
+        Ok(())
+    }
+
+    /// The triangles of one primitive of `mesh`, placed by `world`, with their materials and
+    /// texture coordinates; other modes than triangles are left out with a warning.
+    fn primitive(
+        &mut self,
+        mesh: &gltf::Mesh,
+        prim: &gltf::Primitive,
+        world: Mat4,
+        found: &mut Found,
+    ) -> Result<()> {
+        if prim.mode() != gltf::mesh::Mode::Triangles {
+            self.warn(format!(
+                "mesh {} has a primitive of mode {:?}: only triangles are read",
+                mesh.index(),
+                prim.mode()
+            ));
+            return Ok(());
+        }
+        self.check_accessors(mesh, prim)?;
+        let buffers = self.buffers;
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let Some(positions) = reader.read_positions() else {
+            self.warn(format!(
+                "mesh {} has a primitive without positions",
+                mesh.index()
+            ));
+            return Ok(());
+        };
+        let out = &mut found.out;
+        let first = out.mesh.positions.len() as u32;
+        out.mesh
+            .positions
+            .extend(positions.map(|p| world.transform_point3(Vec3::from(p))));
+        let count = out.mesh.positions.len() as u32 - first;
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..count).collect(),
+        };
+        if let Some(bad) = indices.iter().find(|&&i| i >= count) {
+            return Err(self.fail(format!(
+                "mesh {} indexes vertex {bad} of {count}",
+                mesh.index()
+            )));
+        }
+        let m = match prim.material().index() {
+            Some(i) => i as u32,
+            None => {
+                found.used_default = true;
+                found.default_material
+            }
+        };
+        let mirrored = world.determinant() < 0.0;
+        let set = found.texcoord_sets.get(m as usize).copied().flatten();
+        let uv: Option<Vec<Vec2>> = set
+            .and_then(|set| reader.read_tex_coords(set))
+            .map(|tc| tc.into_f32().map(Vec2::from).collect())
+            .filter(|uv: &Vec<Vec2>| {
+                uv.len() == count as usize && uv.iter().all(|c| c.is_finite())
+            });
+        if set.is_some() && uv.is_none() {
+            self.warn(format!(
+                "mesh {} has a textured primitive without usable texture coordinates: it shows \
+                 the base colour factor",
+                mesh.index()
+            ));
+        }
+        let out = &mut found.out;
+        if let Some(uv) = &uv {
+            out.mesh.texcoords.resize(out.mesh.triangles.len(), None);
+            for t in indices.chunks_exact(3) {
+                let corner = |i: usize| uv[t[i] as usize];
+                let c = if mirrored {
+                    [corner(0), corner(2), corner(1)]
+                } else {
+                    [corner(0), corner(1), corner(2)]
+                };
+                out.mesh.texcoords.push(Some(c));
+            }
+        } else if !out.mesh.texcoords.is_empty() {
+            let n = out.mesh.triangles.len() + indices.len() / 3;
+            out.mesh.texcoords.resize(n, None);
+        }
+        for t in indices.chunks_exact(3) {
+            let t = [first + t[0], first + t[1], first + t[2]];
+            out.mesh
+                .triangles
+                .push(if mirrored { [t[0], t[2], t[1]] } else { t });
+            out.mesh.triangle_materials.push(m);
+        }
+        Ok(())
+    }
+
+    /// Checks every accessor a primitive's triangles are read through: the gltf crate's readers
+    /// trust them (a count of 0 or a stride below the element size underflows in them).
+    fn check_accessors(&self, mesh: &gltf::Mesh, prim: &gltf::Primitive) -> Result<()> {
+        use gltf::accessor::{DataType as T, Dimensions as D};
+        let read = prim
+            .attributes()
+            .filter_map(|(semantic, a)| match semantic {
+                gltf::Semantic::Positions => Some((a, &[T::F32][..], D::Vec3)),
+                gltf::Semantic::TexCoords(_) => Some((a, &[T::F32, T::U8, T::U16][..], D::Vec2)),
+                _ => None,
+            });
+        let indices = prim
+            .indices()
+            .map(|a| (a, &[T::U8, T::U16, T::U32][..], D::Scalar));
+        for (accessor, types, dimensions) in read.chain(indices) {
+            let typed =
+                types.contains(&accessor.data_type()) && accessor.dimensions() == dimensions;
+            let fits = if typed {
+                accessor_fits(&accessor, self.buffers)
+            } else {
+                Err(format!(
+                    "{:?} {:?} elements where glTF allows {types:?} {dimensions:?}",
+                    accessor.data_type(),
+                    accessor.dimensions()
+                ))
+            };
+            fits.map_err(|problem| {
+                self.fail(format!(
+                    "mesh {}: accessor {}: {problem}",
+                    mesh.index(),
+                    accessor.index()
+                ))
+            })?;
+        }
+        Ok(())
+    }
+
+    /// A node's perspective camera, named by the node (what a modelling tool shows: Blender's
+    /// object name), else by itself; orthographic ones are left out with a warning.
+    fn camera(
+        &mut self,
+        node: &gltf::Node,
+        camera: &gltf::Camera,
+        world: Mat4,
+        out: &mut GltfScene,
+    ) -> Result<()> {
+        let p = match camera.projection() {
+            gltf::camera::Projection::Perspective(p) => p,
+            gltf::camera::Projection::Orthographic(_) => {
+                self.warn(format!(
+                    "camera {} is orthographic: only perspective cameras are read",
+                    camera.index()
+                ));
+                return Ok(());
+            }
+        };
+        let position = world.transform_point3(Vec3::ZERO);
+        let forward = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+        let aspect = p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0);
+        let width = 512u32;
+        let height = aspect.map_or(512, |a| ((512.0 / a).round() as u32).max(1));
+        let name = node
+            .name()
+            .or(camera.name())
+            .map_or_else(|| format!("camera {}", camera.index()), str::to_string);
+        let camera = Camera {
+            position,
+            look_at: position + forward,
+            up,
+            fov_y: p.yfov().to_degrees(),
+            width,
+            height,
+        };
+        // The checks a host's camera gets (`Scene::set_camera`).
+        if let Some(problem) = camera.problem() {
+            return Err(self.fail(format!("camera '{name}': {problem}")));
+        }
+        out.cameras.push((name, camera));
+        Ok(())
+    }
+
+    /// A `KHR_lights_punctual` light: a point light, or a spot as a luminaire with its cone;
+    /// directional lights are left out with a warning.
+    fn light(
+        &mut self,
+        light: &gltf::khr_lights_punctual::Light,
+        world: Mat4,
+        out: &mut GltfScene,
+    ) -> Result<()> {
+        let colour = Vec3::from(light.color());
+        let candela = colour * light.intensity();
+        let intensity = if self.photometric {
+            candela
+        } else {
+            candela / EFFICACY
+        };
+        // The checks a host's point light gets: finite, not negative.
+        let point = PointLight {
+            position: world.transform_point3(Vec3::ZERO),
+            intensity,
+        };
+        if let Some(problem) = super::validate::point_light(&point) {
+            return Err(self.fail(format!(
+                "light {} (intensity {}, colour {:?}): {problem}",
+                light.index(),
+                light.intensity(),
+                light.color()
+            )));
+        }
+        match light.kind() {
+            gltf::khr_lights_punctual::Kind::Point => out.point_lights.push(point),
+            gltf::khr_lights_punctual::Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let aim = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+                if aim == Vec3::ZERO {
+                    self.warn(format!(
+                        "light {} is a spot whose node points nowhere: left out",
+                        light.index()
+                    ));
+                } else {
+                    out.luminaires.push(Luminaire {
+                        position: world.transform_point3(Vec3::ZERO),
+                        aim,
+                        c0: aim.any_orthonormal_vector(),
+                        tint: intensity,
+                        photometry: Arc::new(spot_cone(
+                            inner_cone_angle,
+                            outer_cone_angle,
+                            self.falloff,
+                        )),
+                    });
+                }
+            }
+            gltf::khr_lights_punctual::Kind::Directional => self.warn(format!(
+                "light {} is a directional light: only point and spot lights are read",
+                light.index()
+            )),
+        }
+        Ok(())
+    }
 }
 
 /// One glTF material as meshlight's: base colour → Kd, metallic/roughness → the metallic
@@ -398,10 +513,11 @@ pub(super) fn read(
 fn material(
     m: &gltf::Material,
     photometric: bool,
-    (max_reflectance, strict): (f32, bool),
+    rules: &Rules,
     textured: bool,
     warn: &mut dyn FnMut(String),
 ) -> std::result::Result<Material, String> {
+    let (max_reflectance, strict) = (rules.max_reflectance, rules.strict);
     let name = m.name().map_or_else(
         || format!("material {}", m.index().unwrap_or(0)),
         str::to_string,
@@ -555,6 +671,18 @@ enum Falloff {
     /// from the outer angle over (1 − cos outer) × blend, with blend = 1 − inner / outer (how
     /// Blender's exporter wrote the inner angle from the spot's blend).
     Cycles,
+}
+
+impl Falloff {
+    /// Decision: a spot fades as the tool that wrote the file showed it, where we know that
+    /// tool: Blender's files as Cycles draws them (with the specification's falloff a Blender
+    /// spot's room came out 26% darker than in Cycles), others as glTF recommends.
+    fn of(document: &gltf::Document) -> Falloff {
+        match document.as_json().asset.generator.as_deref() {
+            Some(g) if g.starts_with("Khronos glTF Blender") => Falloff::Cycles,
+            _ => Falloff::Gltf,
+        }
+    }
 }
 
 /// A spot's cone as a distribution of peak 1 (the light's intensity is the tint): full inside,

@@ -462,21 +462,15 @@ impl Scene {
             file::Geometry::Gltf(gltf_path) => {
                 // The gltf crate is trusted with hostile files only behind a catch: a panic in
                 // it is an error naming the file, not an abort of the host.
-                let read = crate::parallel::caught(|| {
-                    gltf::read(
-                        files,
-                        gltf_path,
-                        file.units,
-                        (max_reflectance, options.strict),
-                    )
-                })
-                .unwrap_or_else(|panic| {
-                    Err(Error::scene(
-                        gltf_path,
-                        None,
-                        format!("the glTF reader failed on it ({panic})"),
-                    ))
-                })?;
+                let read =
+                    crate::parallel::caught(|| gltf::read(files, gltf_path, file.units, &rules))
+                        .unwrap_or_else(|panic| {
+                            Err(Error::scene(
+                                gltf_path,
+                                None,
+                                format!("the glTF reader failed on it ({panic})"),
+                            ))
+                        })?;
                 point_lights.extend(read.point_lights);
                 luminaires.extend(read.luminaires);
                 match &options.camera {
@@ -519,7 +513,7 @@ impl Scene {
             path,
             &file.overrides,
             &mut mesh.materials,
-            (max_reflectance, options.strict),
+            &rules,
             &mut warnings,
         )?;
         let parts = SceneParts {

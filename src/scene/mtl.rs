@@ -104,151 +104,26 @@ pub(super) fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibr
     let mut warnings = Vec::new();
     for (i, raw) in text.split('\n').enumerate() {
         let line = i + 1;
-        let fail = |problem: String| Err(Error::scene(path, Some(line), problem));
         let mut words = raw.split_whitespace();
-        match words.next() {
-            Some("newmtl") => {
-                let name = raw.trim()["newmtl".len()..].trim();
-                if name.is_empty() {
-                    return fail("newmtl without a material name".into());
-                }
-                if let Some(first) = seen.insert(name.to_string(), line) {
-                    return fail(format!(
-                        "material '{name}' is defined twice (lines {first} and {line})"
-                    ));
-                }
-                materials.push(MtlLines {
-                    name: name.into(),
-                    line,
-                    kd_line: None,
-                    ke_line: None,
-                    ks: None,
-                    ns: None,
-                    pr: None,
-                    pm: None,
-                    ni: None,
-                    tf: None,
-                    illum: None,
-                    map_kd: None,
-                });
+        let key = words.next();
+        let read = match key {
+            Some("newmtl") => newmtl(raw, line, &mut seen).map(|name| {
                 out.push_str("newmtl ");
-                out.push_str(name);
-            }
-            Some(key @ ("Kd" | "Ke")) => {
-                let Some(current) = materials.last_mut() else {
-                    return fail(format!("{key} before any newmtl"));
-                };
-                let values: Vec<&str> = words.collect();
-                let numbers: Vec<f32> = values.iter().filter_map(|w| w.parse().ok()).collect();
-                let rgb = match numbers[..] {
-                    [r, g, b] if values.len() == 3 => [r, g, b],
-                    [v] if values.len() == 1 => [v; 3],
-                    _ => {
-                        return fail(format!(
-                            "material '{}': {key} needs three numbers r g b, found '{}'",
-                            current.name,
-                            values.join(" ")
-                        ))
-                    }
-                };
-                *if key == "Kd" {
-                    &mut current.kd_line
-                } else {
-                    &mut current.ke_line
-                } = Some(line);
-                out.push_str(&format!("{key} {} {} {}", rgb[0], rgb[1], rgb[2]));
-            }
-            Some(key @ ("Ks" | "Tf")) => {
-                let Some(current) = materials.last_mut() else {
-                    return fail(format!("{key} before any newmtl"));
-                };
-                let values: Vec<&str> = words.collect();
-                let numbers: Vec<f32> = values.iter().filter_map(|w| w.parse().ok()).collect();
-                let rgb = match numbers[..] {
-                    [r, g, b] if values.len() == 3 => Vec3::new(r, g, b),
-                    [v] if values.len() == 1 => Vec3::splat(v),
-                    _ => {
-                        return fail(format!(
-                            "material '{}': {key} needs three numbers r g b, found '{}' (spectral \
-                             and CIE XYZ forms are not read)",
-                            current.name,
-                            values.join(" ")
-                        ))
-                    }
-                };
-                if !rgb.is_finite() || rgb.min_element() < 0.0 || rgb.max_element() > 1.0 {
-                    return fail(format!(
-                        "material '{}': {key} {} {} {} is outside [0, 1]",
-                        current.name, rgb.x, rgb.y, rgb.z
-                    ));
+                out.push_str(&name);
+                materials.push(MtlLines::new(name, line));
+            }),
+            Some(
+                key @ ("Kd" | "Ke" | "Ks" | "Tf" | "Ns" | "Pr" | "Pm" | "Ni" | "illum" | "map_Kd"),
+            ) => match materials.last_mut() {
+                None => Err(format!("{key} before any newmtl")),
+                Some(current) => {
+                    let values: Vec<&str> = words.collect();
+                    current.read(key, values, line, &mut out, &mut warnings, path)
                 }
-                *if key == "Ks" {
-                    &mut current.ks
-                } else {
-                    &mut current.tf
-                } = Some((rgb, line));
-            }
-            Some(key @ ("Ns" | "Pr" | "Pm" | "Ni")) => {
-                let Some(current) = materials.last_mut() else {
-                    return fail(format!("{key} before any newmtl"));
-                };
-                let values: Vec<&str> = words.collect();
-                let value = match values[..] {
-                    [v] => v.parse::<f32>().ok().filter(|v| v.is_finite()),
-                    _ => None,
-                };
-                let Some(value) = value else {
-                    return fail(format!(
-                        "material '{}': {key} needs one number, found '{}'",
-                        current.name,
-                        values.join(" ")
-                    ));
-                };
-                let (slot, range) = match key {
-                    "Ns" => (&mut current.ns, 0.0..=f32::MAX),
-                    "Pr" => (&mut current.pr, 0.0..=1.0),
-                    "Pm" => (&mut current.pm, 0.0..=1.0),
-                    _ => (&mut current.ni, 0.0..=f32::MAX),
-                };
-                if !range.contains(&value) {
-                    return fail(format!(
-                        "material '{}': {key} {value} is outside [{}, {}]",
-                        current.name,
-                        range.start(),
-                        if *range.end() == f32::MAX {
-                            "∞".to_string()
-                        } else {
-                            range.end().to_string()
-                        }
-                    ));
-                }
-                *slot = Some((value, line));
-            }
-            Some("map_Kd") => {
-                let Some(current) = materials.last_mut() else {
-                    return fail("map_Kd before any newmtl".into());
-                };
-                let name = current.name.clone();
-                let map = map_kd(&name, words.collect(), line, path, &mut warnings)
-                    .map_err(|problem| Error::scene(path, Some(line), problem))?;
-                current.map_kd = Some(map);
-            }
-            Some("illum") => {
-                let Some(current) = materials.last_mut() else {
-                    return fail("illum before any newmtl".into());
-                };
-                let values: Vec<&str> = words.collect();
-                let Some(model) = values.first().and_then(|v| v.parse::<u32>().ok()) else {
-                    return fail(format!(
-                        "material '{}': illum needs an illumination model number, found '{}'",
-                        current.name,
-                        values.join(" ")
-                    ));
-                };
-                current.illum = Some((model, line));
-            }
-            _ => {}
-        }
+            },
+            _ => Ok(()),
+        };
+        read.map_err(|problem| Error::scene(path, Some(line), problem))?;
         out.push('\n');
     }
     Ok(MtlLibrary {
@@ -257,6 +132,154 @@ pub(super) fn read_mtl(files: &dyn super::Source, path: &Path) -> Result<MtlLibr
         text: out,
         materials,
     })
+}
+
+/// `newmtl NAME`: the name, once per file.
+fn newmtl(
+    raw: &str,
+    line: usize,
+    seen: &mut HashMap<String, usize>,
+) -> std::result::Result<String, String> {
+    let name = raw.trim()["newmtl".len()..].trim();
+    if name.is_empty() {
+        return Err("newmtl without a material name".into());
+    }
+    if let Some(first) = seen.insert(name.to_string(), line) {
+        return Err(format!(
+            "material '{name}' is defined twice (lines {first} and {line})"
+        ));
+    }
+    Ok(name.to_string())
+}
+
+impl MtlLines {
+    /// A material's lines before any statement of it.
+    fn new(name: String, line: usize) -> MtlLines {
+        MtlLines {
+            name,
+            line,
+            kd_line: None,
+            ke_line: None,
+            ks: None,
+            ns: None,
+            pr: None,
+            pm: None,
+            ni: None,
+            tf: None,
+            illum: None,
+            map_kd: None,
+        }
+    }
+
+    /// One statement `key values` of this material, on `line`: Kd and Ke go on to tobj (into
+    /// `out`, normalised), the rest is kept here; `map_Kd`'s warnings (naming `path`) into
+    /// `warnings`.
+    fn read(
+        &mut self,
+        key: &str,
+        values: Vec<&str>,
+        line: usize,
+        out: &mut String,
+        warnings: &mut Vec<String>,
+        path: &Path,
+    ) -> std::result::Result<(), String> {
+        match key {
+            "Kd" | "Ke" => {
+                let rgb = self.colour(key, &values, "")?;
+                *if key == "Kd" {
+                    &mut self.kd_line
+                } else {
+                    &mut self.ke_line
+                } = Some(line);
+                out.push_str(&format!("{key} {} {} {}", rgb.x, rgb.y, rgb.z));
+            }
+            "Ks" | "Tf" => {
+                let rgb =
+                    self.colour(key, &values, " (spectral and CIE XYZ forms are not read)")?;
+                if !rgb.is_finite() || rgb.min_element() < 0.0 || rgb.max_element() > 1.0 {
+                    return Err(format!(
+                        "material '{}': {key} {} {} {} is outside [0, 1]",
+                        self.name, rgb.x, rgb.y, rgb.z
+                    ));
+                }
+                *if key == "Ks" {
+                    &mut self.ks
+                } else {
+                    &mut self.tf
+                } = Some((rgb, line));
+            }
+            "Ns" | "Pr" | "Pm" | "Ni" => self.scalar(key, &values, line)?,
+            "map_Kd" => {
+                self.map_kd = Some(map_kd(&self.name.clone(), values, line, path, warnings)?);
+            }
+            _ => {
+                // illum
+                let Some(model) = values.first().and_then(|v| v.parse::<u32>().ok()) else {
+                    return Err(format!(
+                        "material '{}': illum needs an illumination model number, found '{}'",
+                        self.name,
+                        values.join(" ")
+                    ));
+                };
+                self.illum = Some((model, line));
+            }
+        }
+        Ok(())
+    }
+
+    /// `key r g b` (or one number for all three), `note` said of what is not read.
+    fn colour(&self, key: &str, values: &[&str], note: &str) -> std::result::Result<Vec3, String> {
+        let numbers: Vec<f32> = values.iter().filter_map(|w| w.parse().ok()).collect();
+        match numbers[..] {
+            [r, g, b] if values.len() == 3 => Ok(Vec3::new(r, g, b)),
+            [v] if values.len() == 1 => Ok(Vec3::splat(v)),
+            _ => Err(format!(
+                "material '{}': {key} needs three numbers r g b, found '{}'{note}",
+                self.name,
+                values.join(" ")
+            )),
+        }
+    }
+
+    /// `Ns`, `Pr`, `Pm` or `Ni`: one finite number in the key's range.
+    fn scalar(
+        &mut self,
+        key: &str,
+        values: &[&str],
+        line: usize,
+    ) -> std::result::Result<(), String> {
+        let value = match values[..] {
+            [v] => v.parse::<f32>().ok().filter(|v| v.is_finite()),
+            _ => None,
+        };
+        let Some(value) = value else {
+            return Err(format!(
+                "material '{}': {key} needs one number, found '{}'",
+                self.name,
+                values.join(" ")
+            ));
+        };
+        let name = self.name.clone();
+        let (slot, range) = match key {
+            "Ns" => (&mut self.ns, 0.0..=f32::MAX),
+            "Pr" => (&mut self.pr, 0.0..=1.0),
+            "Pm" => (&mut self.pm, 0.0..=1.0),
+            _ => (&mut self.ni, 0.0..=f32::MAX),
+        };
+        if !range.contains(&value) {
+            return Err(format!(
+                "material '{name}': {key} {value} is outside [{}, {}]",
+                range.start(),
+                if *range.end() == f32::MAX {
+                    "∞".to_string()
+                } else {
+                    range.end().to_string()
+                }
+            ));
+        }
+        *slot = Some((value, line));
+        Ok(())
+    }
 }
 
 /// Our materials from tobj's, checked, each error at its MTL file and line.

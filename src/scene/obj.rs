@@ -228,181 +228,236 @@ struct PreparedObj {
 const NO_VT: u32 = u32::MAX;
 
 fn prepare_obj(path: &Path, text: &str) -> Result<PreparedObj> {
-    let mut out = String::with_capacity(text.len());
-    let mut usemtl = Vec::new();
-    let mut mtllib = Vec::new();
-    let mut short_faces = 0;
-    let mut vertices: i64 = 0;
-    let mut largest_index: Option<(i64, usize)> = None;
-    let mut vt = Vec::new();
-    let mut triangle_vt = Vec::new();
-    let mut largest_vt: Option<(i64, usize)> = None;
+    let mut p = Preparing {
+        out: String::with_capacity(text.len()),
+        ..Preparing::default()
+    };
     for (i, raw) in text.split('\n').enumerate() {
         let line = i + 1;
-        let fail = |problem: String| Err(Error::scene(path, Some(line), problem));
         let mut words = raw.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                let coords: Vec<&str> = words.by_ref().take(3).collect();
-                let parsed: Vec<f32> = coords.iter().filter_map(|w| w.parse().ok()).collect();
-                if parsed.len() != 3 {
-                    return fail(format!(
-                        "vertex needs three numbers x y z, found '{}'",
-                        coords.join(" ")
-                    ));
-                }
-                if let Some(problem) = validate::position(Vec3::from_slice(&parsed)) {
-                    return fail(format!("vertex {}: {problem}", vertices + 1));
-                }
-                out.push_str("v ");
-                out.push_str(&coords.join(" "));
-                vertices += 1;
-            }
-            Some("vt") => {
-                let coords: Vec<&str> = words.collect();
-                let parsed: Vec<f32> = coords.iter().filter_map(|w| w.parse().ok()).collect();
-                if parsed.len() != coords.len()
-                    || !(1..=3).contains(&parsed.len())
-                    || !parsed.iter().all(|c| c.is_finite())
-                {
-                    return fail(format!(
-                        "texture coordinates need one to three finite numbers u [v [w]], found \
-                         '{}'",
-                        coords.join(" ")
-                    ));
-                }
-                vt.push(Vec2::new(parsed[0], parsed.get(1).copied().unwrap_or(0.0)));
-            }
-            Some("f") => {
-                let mut indices = Vec::new();
-                let mut corners_vt = Vec::new();
-                for word in words {
-                    let mut parts = word.split('/');
-                    let first = parts.next().unwrap_or("");
-                    let texture = parts.next().filter(|t| !t.is_empty());
-                    corners_vt.push(match texture {
-                        None => NO_VT as i64,
-                        Some(t) => {
-                            let Ok(index) = t.parse::<i64>() else {
-                                return fail(format!(
-                                    "face vertex '{word}': texture index '{t}' is not a number"
-                                ));
-                            };
-                            let count = vt.len() as i64;
-                            match index {
-                                0 => {
-                                    return fail(
-                                        "texture index 0 in a face: OBJ indices start at 1".into(),
-                                    )
-                                }
-                                i if i < 0 && -i > count => {
-                                    return fail(format!(
-                                        "relative texture index {i} points before the first vt \
-                                         ({count} defined so far)"
-                                    ))
-                                }
-                                i if i < 0 => count + i,
-                                i => {
-                                    if largest_vt.is_none_or(|(largest, _)| i > largest) {
-                                        largest_vt = Some((i, line));
-                                    }
-                                    i - 1
-                                }
-                            }
-                        }
-                    });
-                    let Ok(index) = first.parse::<i64>() else {
-                        return fail(format!(
-                            "face vertex '{word}' does not start with a vertex index"
-                        ));
-                    };
-                    let absolute = match index {
-                        0 => {
-                            return fail("vertex index 0 in a face: OBJ indices start at 1".into())
-                        }
-                        i if i < 0 => {
-                            if -i > vertices {
-                                return fail(format!(
-                                    "relative vertex index {i} points before the first vertex \
-                                     ({vertices} defined so far)"
-                                ));
-                            }
-                            vertices + i + 1
-                        }
-                        i => {
-                            if largest_index.is_none_or(|(largest, _)| i > largest) {
-                                largest_index = Some((i, line));
-                            }
-                            i
-                        }
-                    };
-                    indices.push(absolute);
-                }
-                if indices.len() < 3 {
-                    short_faces += 1;
-                } else {
-                    let corner = |i: usize| u32::try_from(corners_vt[i]).unwrap_or(NO_VT);
-                    for i in 1..indices.len() - 1 {
-                        triangle_vt.push([corner(0), corner(i), corner(i + 1)]);
-                    }
-                    out.push('f');
-                    for index in indices {
-                        out.push(' ');
-                        out.push_str(&index.to_string());
-                    }
-                }
-            }
-            Some(keyword @ ("usemtl" | "mtllib")) => {
-                let name = raw.trim()[keyword.len()..].trim();
-                if name.is_empty() {
-                    return fail(format!("{keyword} without a name"));
-                }
-                if keyword == "usemtl" {
-                    usemtl.push((name.to_string(), line));
-                } else {
-                    mtllib.push((name.to_string(), line));
-                }
-                out.push_str(keyword);
-                out.push(' ');
-                out.push_str(name);
-            }
-            // Comments, texture coordinates, normals, groups, smoothing, lines, points and the
-            // rest are not used: the line stays, empty, so line numbers do not move.
-            _ => {}
-        }
-        out.push('\n');
+        let done = match words.next() {
+            Some("v") => p.vertex(words),
+            Some("vt") => p.texcoord(words),
+            Some("f") => p.face(words, line),
+            Some(keyword @ ("usemtl" | "mtllib")) => p.named(keyword, raw, line),
+            // Comments, normals, groups, smoothing, lines, points and the rest are not used:
+            // the line stays, empty, so line numbers do not move.
+            _ => Ok(()),
+        };
+        done.map_err(|problem| Error::scene(path, Some(line), problem))?;
+        p.out.push('\n');
     }
-    if let Some((index, line)) = largest_index {
-        if index > vertices {
-            return Err(Error::scene(
-                path,
-                Some(line),
-                format!(
-                    "vertex index {index} is out of range: the file defines {vertices} vertices"
-                ),
+    p.finish()
+        .map_err(|(line, problem)| Error::scene(path, Some(line), problem))
+}
+
+/// An OBJ text on its way to tobj: what is kept of it, and what the check has learnt.
+#[derive(Default)]
+struct Preparing {
+    out: String,
+    usemtl: Vec<(String, usize)>,
+    mtllib: Vec<(String, usize)>,
+    short_faces: usize,
+    vertices: i64,
+    /// The largest vertex index a face names, with its line.
+    largest_index: Option<(i64, usize)>,
+    vt: Vec<Vec2>,
+    triangle_vt: Vec<[u32; 3]>,
+    /// The largest texture index a face names, with its line.
+    largest_vt: Option<(i64, usize)>,
+}
+
+impl Preparing {
+    /// `v x y z`: three finite numbers.
+    fn vertex<'w>(
+        &mut self,
+        mut words: impl Iterator<Item = &'w str>,
+    ) -> std::result::Result<(), String> {
+        let coords: Vec<&str> = words.by_ref().take(3).collect();
+        let parsed: Vec<f32> = coords.iter().filter_map(|w| w.parse().ok()).collect();
+        if parsed.len() != 3 {
+            return Err(format!(
+                "vertex needs three numbers x y z, found '{}'",
+                coords.join(" ")
             ));
         }
+        if let Some(problem) = validate::position(Vec3::from_slice(&parsed)) {
+            return Err(format!("vertex {}: {problem}", self.vertices + 1));
+        }
+        self.out.push_str("v ");
+        self.out.push_str(&coords.join(" "));
+        self.vertices += 1;
+        Ok(())
     }
-    if let Some((index, line)) = largest_vt {
-        if index > vt.len() as i64 {
-            return Err(Error::scene(
-                path,
-                Some(line),
-                format!(
-                    "texture index {index} is out of range: the file defines {} vt",
-                    vt.len()
-                ),
+
+    /// `vt u [v [w]]`: kept here (tobj is not given them).
+    fn texcoord<'w>(
+        &mut self,
+        words: impl Iterator<Item = &'w str>,
+    ) -> std::result::Result<(), String> {
+        let coords: Vec<&str> = words.collect();
+        let parsed: Vec<f32> = coords.iter().filter_map(|w| w.parse().ok()).collect();
+        if parsed.len() != coords.len()
+            || !(1..=3).contains(&parsed.len())
+            || !parsed.iter().all(|c| c.is_finite())
+        {
+            return Err(format!(
+                "texture coordinates need one to three finite numbers u [v [w]], found '{}'",
+                coords.join(" ")
             ));
         }
+        self.vt
+            .push(Vec2::new(parsed[0], parsed.get(1).copied().unwrap_or(0.0)));
+        Ok(())
     }
-    Ok(PreparedObj {
-        text: out,
-        usemtl,
-        mtllib,
-        short_faces,
-        vt,
-        triangle_vt,
-    })
+
+    /// `f v[/vt[/vn]] ...`: absolute vertex indices for tobj, each triangle's texture indices
+    /// kept here; faces of fewer than three corners are counted and left out.
+    fn face<'w>(
+        &mut self,
+        words: impl Iterator<Item = &'w str>,
+        line: usize,
+    ) -> std::result::Result<(), String> {
+        let mut indices = Vec::new();
+        let mut corners_vt = Vec::new();
+        for word in words {
+            let mut parts = word.split('/');
+            let first = parts.next().unwrap_or("");
+            let texture = parts.next().filter(|t| !t.is_empty());
+            corners_vt.push(match texture {
+                None => NO_VT as i64,
+                Some(t) => self.texture_index(word, t, line)?,
+            });
+            indices.push(self.vertex_index(word, first, line)?);
+        }
+        if indices.len() < 3 {
+            self.short_faces += 1;
+            return Ok(());
+        }
+        let corner = |i: usize| u32::try_from(corners_vt[i]).unwrap_or(NO_VT);
+        for i in 1..indices.len() - 1 {
+            self.triangle_vt.push([corner(0), corner(i), corner(i + 1)]);
+        }
+        self.out.push('f');
+        for index in indices {
+            self.out.push(' ');
+            self.out.push_str(&index.to_string());
+        }
+        Ok(())
+    }
+
+    /// A face corner's texture index `t` (of `word`), 0-based.
+    fn texture_index(
+        &mut self,
+        word: &str,
+        t: &str,
+        line: usize,
+    ) -> std::result::Result<i64, String> {
+        let Ok(index) = t.parse::<i64>() else {
+            return Err(format!(
+                "face vertex '{word}': texture index '{t}' is not a number"
+            ));
+        };
+        let count = self.vt.len() as i64;
+        match index {
+            0 => Err("texture index 0 in a face: OBJ indices start at 1".into()),
+            i if i < 0 && -i > count => Err(format!(
+                "relative texture index {i} points before the first vt ({count} defined so far)"
+            )),
+            i if i < 0 => Ok(count + i),
+            i => {
+                if self.largest_vt.is_none_or(|(largest, _)| i > largest) {
+                    self.largest_vt = Some((i, line));
+                }
+                Ok(i - 1)
+            }
+        }
+    }
+
+    /// A face corner's vertex index `first` (of `word`), absolute and 1-based.
+    fn vertex_index(
+        &mut self,
+        word: &str,
+        first: &str,
+        line: usize,
+    ) -> std::result::Result<i64, String> {
+        let Ok(index) = first.parse::<i64>() else {
+            return Err(format!(
+                "face vertex '{word}' does not start with a vertex index"
+            ));
+        };
+        match index {
+            0 => Err("vertex index 0 in a face: OBJ indices start at 1".into()),
+            i if i < 0 => {
+                if -i > self.vertices {
+                    return Err(format!(
+                        "relative vertex index {i} points before the first vertex ({} defined so \
+                         far)",
+                        self.vertices
+                    ));
+                }
+                Ok(self.vertices + i + 1)
+            }
+            i => {
+                if self.largest_index.is_none_or(|(largest, _)| i > largest) {
+                    self.largest_index = Some((i, line));
+                }
+                Ok(i)
+            }
+        }
+    }
+
+    /// `usemtl NAME` or `mtllib FILE...`: kept with their line.
+    fn named(&mut self, keyword: &str, raw: &str, line: usize) -> std::result::Result<(), String> {
+        let name = raw.trim()[keyword.len()..].trim();
+        if name.is_empty() {
+            return Err(format!("{keyword} without a name"));
+        }
+        if keyword == "usemtl" {
+            self.usemtl.push((name.to_string(), line));
+        } else {
+            self.mtllib.push((name.to_string(), line));
+        }
+        self.out.push_str(keyword);
+        self.out.push(' ');
+        self.out.push_str(name);
+        Ok(())
+    }
+
+    /// The prepared text, once every index a face named is known to exist (a line and the
+    /// problem where one does not).
+    fn finish(self) -> std::result::Result<PreparedObj, (usize, String)> {
+        if let Some((index, line)) = self.largest_index {
+            if index > self.vertices {
+                return Err((
+                    line,
+                    format!(
+                        "vertex index {index} is out of range: the file defines {} vertices",
+                        self.vertices
+                    ),
+                ));
+            }
+        }
+        if let Some((index, line)) = self.largest_vt {
+            if index > self.vt.len() as i64 {
+                return Err((
+                    line,
+                    format!(
+                        "texture index {index} is out of range: the file defines {} vt",
+                        self.vt.len()
+                    ),
+                ));
+            }
+        }
+        Ok(PreparedObj {
+            text: self.out,
+            usemtl: self.usemtl,
+            mtllib: self.mtllib,
+            short_faces: self.short_faces,
+            vt: self.vt,
+            triangle_vt: self.triangle_vt,
+        })
+    }
 }
 
 /// A `usemtl` naming a material no MTL file defines is one warning per name; its faces get the

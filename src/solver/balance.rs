@@ -28,9 +28,9 @@ pub(super) const MAX_CORRECTION: f64 = 0.02;
 pub(super) fn closed_to_the_lights(
     scene: &Scene,
     vis: &dyn Visibility,
-    lift: f32,
-    (seed, threads): (u64, usize),
+    exec: crate::exec::Exec,
 ) -> Result<bool> {
+    let (seed, lift) = (exec.seed, crate::visibility::lift(scene));
     if !scene.point_sources().is_empty() || scene.emitters().next().is_none() {
         return Ok(false);
     }
@@ -39,7 +39,7 @@ pub(super) fn closed_to_the_lights(
         let mut rng = Pcg64Mcg::seed_from_u64(seed ^ (0x6261_6c61_6e63_6500 + u64::from(s)));
         rays.extend(leaving::rays(scene, s, RAYS_PER_LIGHT, lift, &mut rng));
     }
-    let hits = crate::visibility::intersect_all(vis, &rays, threads)?;
+    let hits = crate::visibility::intersect_all(vis, &rays, exec.threads)?;
     Ok(hits.iter().all(Option::is_some))
 }
 

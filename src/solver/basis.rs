@@ -109,8 +109,7 @@ impl<'a> Basis<'a> {
         let n = self.solution.field.samples.len();
         let hierarchical = !options.flat();
         Settings {
-            ranks: &crate::distributed::Single,
-            threads: options.threads.max(1),
+            exec: crate::exec::Exec::local(options.threads, options.seed),
             capacity: options.pipeline_capacity.max(1),
             // Ten times looser than the solve's: each basis's first light is exact (at the
             // samples and, straight in, at the grid points), and what is left unshot is carried
@@ -128,7 +127,6 @@ impl<'a> Basis<'a> {
             normalise: false,
             threshold: options.cluster_threshold,
             exact_visibility: options.exact_visibility,
-            seed: options.seed,
         }
     }
 

@@ -12,6 +12,7 @@ pub(crate) mod basis;
 mod cluster;
 mod flat;
 mod form_factor;
+mod knobs;
 mod normalise;
 mod options;
 mod phases;
@@ -28,17 +29,19 @@ use glam::DVec3;
 pub use crate::area::AreaStats;
 use crate::budget::{human_bytes, human_count, human_number, BYTES_PER_SAMPLE};
 use crate::error::{Error, Result};
-use crate::field::{Field, Layout};
+use crate::field::Field;
 pub use crate::light::Arrival;
 use crate::light::{DirectLight, Reach};
 use crate::progress::Reporter;
 pub use crate::progress::{Control, Phase, Progress};
+use crate::sampling::Layout;
 pub use crate::sampling::Samples;
 use crate::sampling::{reflecting_sides, surface_of, Obstruction, SurfaceMap};
 use crate::scene::Scene;
 pub use crate::specular::{summary as specular_summary, SpecularSummary, MAX_SPECULAR_DEPTH};
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
+pub use knobs::{knob, Knob, KNOBS, MAX_PIPELINE_CAPACITY, MAX_THREADS};
 pub use options::{
     Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH, MAX_PHOTONS,
     MAX_SPECULAR_RAYS,
@@ -384,7 +387,7 @@ fn solve_with(
     progress: crate::progress::Callback,
     method: Method,
 ) -> Result<Solution> {
-    check(options)?;
+    options.validate()?;
     let (epsilon, epsilon_source) = choose_epsilon(scene, options)?;
     let predicted = predicted_samples(scene, epsilon);
     if predicted > options.max_samples as f64 {
@@ -535,102 +538,6 @@ pub fn transfer(
         }
         Ok(irradiance)
     })
-}
-
-/// The most worker threads a call takes: far beyond any machine this runs on, and well short of
-/// what spawning would exhaust.
-pub const MAX_THREADS: usize = 1024;
-
-/// The most jobs the solver's pipeline may hold in flight ([`Options::pipeline_capacity`]).
-pub const MAX_PIPELINE_CAPACITY: usize = 4096;
-
-fn check(options: &Options) -> Result<()> {
-    let fail = |option, problem: String| Err(Error::Option { option, problem });
-    if !(options.epsilon_scale.is_finite() && (0.0625..=16.0).contains(&options.epsilon_scale)) {
-        return fail(
-            "epsilon_scale",
-            format!("{} must lie in [1/16, 16]", options.epsilon_scale),
-        );
-    }
-    if !(options.alpha.is_finite() && options.alpha >= 0.0) {
-        return fail(
-            "alpha",
-            format!("{} must be a finite number ≥ 0", options.alpha),
-        );
-    }
-    if !(options.zeta.is_finite() && options.zeta > 0.0) {
-        return fail(
-            "zeta",
-            format!("{} must be a positive number", options.zeta),
-        );
-    }
-    if !(options.tolerance.is_finite() && options.tolerance > 0.0 && options.tolerance < 1.0) {
-        return fail(
-            "tolerance",
-            format!("{} must lie in (0, 1)", options.tolerance),
-        );
-    }
-    if options.light_samples == 0 || options.light_samples > crate::light::MAX_LIGHT_SAMPLES {
-        return fail(
-            "light_samples",
-            format!(
-                "{} must lie in 1..={}",
-                options.light_samples,
-                crate::light::MAX_LIGHT_SAMPLES
-            ),
-        );
-    }
-    if options.specular_rays == 0 || options.specular_rays > MAX_SPECULAR_RAYS {
-        return fail(
-            "specular_rays",
-            format!(
-                "{} must lie in 1..={MAX_SPECULAR_RAYS}",
-                options.specular_rays
-            ),
-        );
-    }
-    if options.photons == 0 || options.photons > MAX_PHOTONS {
-        return fail(
-            "photons",
-            format!("{} must lie in 1..={MAX_PHOTONS}", options.photons),
-        );
-    }
-    if options.specular_depth > crate::specular::MAX_SPECULAR_DEPTH {
-        return fail(
-            "specular_depth",
-            format!(
-                "{} must lie in 0..={}",
-                options.specular_depth,
-                crate::specular::MAX_SPECULAR_DEPTH
-            ),
-        );
-    }
-    if !(1..=MAX_THREADS).contains(&options.threads) {
-        return fail(
-            "threads",
-            format!("{} must lie in 1..={MAX_THREADS}", options.threads),
-        );
-    }
-    if !(1..=MAX_PIPELINE_CAPACITY).contains(&options.pipeline_capacity) {
-        return fail(
-            "pipeline_capacity",
-            format!(
-                "{} jobs in flight: it must lie in 1..={MAX_PIPELINE_CAPACITY} (each job in \
-                 flight may hold a group's links, megabytes, against the budget)",
-                options.pipeline_capacity
-            ),
-        );
-    }
-    if !(options.cluster_threshold.is_finite() && options.cluster_threshold >= 0.0) {
-        return fail(
-            "cluster_threshold",
-            format!(
-                "{} must be a finite number ≥ 0 (0: the flat solver)",
-                options.cluster_threshold
-            ),
-        );
-    }
-    Ok(())
 }
 
 #[cfg(test)]

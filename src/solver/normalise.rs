@@ -44,17 +44,17 @@ pub(crate) fn row_scale(sum: f64, closed: bool, dark_emitters: f64) -> f32 {
 /// row unnormalised. Rays, not segments: a segment ignores
 /// hits near its ends, which lets a probe from a sample beside an edge slip past the
 /// neighbouring face.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn closed_hemispheres(
     scene: &Scene,
     reflecting: &[bool],
     samples: &Samples,
     first: usize,
     vis: &dyn Visibility,
-    (seed, threads): (u64, usize),
-    lift: f32,
+    exec: crate::exec::Exec,
     report: Report,
 ) -> Result<Vec<bool>> {
+    let (seed, threads) = (exec.seed, exec.threads);
+    let lift = crate::visibility::lift(scene);
     let diagonal = scene.bounds.diagonal();
     let mut out = vec![true; samples.len() - first];
     let probe = |start: usize, chunk: &mut [bool]| {

@@ -133,6 +133,25 @@ impl Default for Options {
 }
 
 impl Options {
+    /// Checks every knob's value ([`KNOBS`](crate::solver::KNOBS)): the first out of its range,
+    /// as [`Error::Option`](crate::Error::Option) naming it. [`solve`](crate::solve) checks
+    /// them too, before it starts.
+    pub fn validate(&self) -> crate::Result<()> {
+        super::knobs::KNOBS.iter().try_for_each(|k| k.check(self))
+    }
+
+    /// Sets the knob `name` (a field's name, or spelt with hyphens as on the command line) from
+    /// its text form, and checks its value.
+    pub fn set(&mut self, name: &str, text: &str) -> crate::Result<()> {
+        match super::knobs::knob(name) {
+            Some(k) => k.set(self, text),
+            None => Err(crate::Error::argument(
+                "knob",
+                format!("unknown '{name}' (see meshlight::solver::KNOBS)"),
+            )),
+        }
+    }
+
     /// Whether these options select the flat solver (every sample linked to every sample):
     /// a cluster threshold of 0. The one place that says what the threshold selects.
     pub fn flat(&self) -> bool {

@@ -64,11 +64,11 @@ pub(super) struct AddedSamples {
 fn arrive(
     light: &DirectLight,
     vis: &dyn Visibility,
-    ranks: &dyn crate::distributed::Ranks,
+    exec: crate::exec::Exec,
     (points, ids): (&[(Vec3, Vec3)], &[u32]),
-    (seed, threads): (u64, usize),
     report: crate::parallel::Report,
 ) -> Result<(Vec<Arrival>, u64)> {
+    let (ranks, seed, threads) = (exec.ranks, exec.seed, exec.threads);
     let mine = crate::distributed::share_of(ranks, points.len(), DirectLight::CHUNK);
     let (part, queries) = light.at(
         vis,
@@ -103,7 +103,12 @@ fn arrive(
     Ok((arrivals, crate::distributed::sum_over(ranks, queries)?))
 }
 
-impl Solve<'_> {
+impl<'a> Solve<'a> {
+    /// How the stages run: the options' threads and seed, over the solve's ranks.
+    fn exec(&self) -> crate::exec::Exec<'a> {
+        crate::exec::Exec::new(self.options.threads, self.options.seed, self.ranks)
+    }
+
     /// The report of `phase` in `round` over `samples` samples, nothing done yet.
     fn base(&self, phase: Phase, round: u32, samples: usize) -> Progress {
         Progress {
@@ -241,12 +246,10 @@ impl Solve<'_> {
         let base = self.base(Phase::Areas, round, n);
         let stats = area::compute(
             &mut solution.field.samples,
-            solution.field.layout.maps(),
-            solution.field.layout.index(),
-            solution.field.layout.obstruction(),
+            &solution.field.layout,
             self.vis,
-            (self.epsilon, self.options.alpha),
-            (self.options.threads.max(1), self.ranks),
+            self.options.alpha,
+            self.exec(),
             added.changed.as_deref(),
             &mut self.reporter.part(base),
         )?;
@@ -268,8 +271,7 @@ impl Solve<'_> {
         if self.specular.is_some() || self.reporter.stopped() || self.scene.daylight().is_some() {
             return Ok(DVec3::ONE);
         }
-        let settings = (self.options.seed, self.options.threads.max(1));
-        if !balance::closed_to_the_lights(self.scene, self.vis, self.lift, settings)? {
+        if !balance::closed_to_the_lights(self.scene, self.vis, self.exec())? {
             return Ok(DVec3::ONE);
         }
         let area = &solution.field.samples.area;
@@ -307,15 +309,9 @@ impl Solve<'_> {
         } else {
             let base = self.base(Phase::DirectLight, round, n);
             let at = (points.as_slice(), ids.as_slice());
+            let exec = self.exec();
             let mut report = self.reporter.part(base);
-            let (arrivals, queries) = arrive(
-                &self.light,
-                vis,
-                self.ranks,
-                at,
-                (options.seed, threads),
-                &mut report,
-            )?;
+            let (arrivals, queries) = arrive(&self.light, vis, exec, at, &mut report)?;
             let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
             (arrivals, queries, covered)
         };
@@ -335,9 +331,8 @@ impl Solve<'_> {
             vis,
             first_new,
             &arrivals,
-            self.epsilon,
             options.alpha,
-            (threads, self.ranks),
+            self.exec(),
         )?;
         if round == 0 && !solution.field.daylight.is_empty() {
             // Daylight is a source too: what enters is what the shooting measures against (the
@@ -429,22 +424,15 @@ impl Solve<'_> {
             return Ok(0);
         };
         let (scene, vis, options) = (self.scene, self.vis, self.options);
-        let threads = options.threads.max(1);
         let n = solution.field.samples.len();
         let mut queries = 0;
         // The chains of the new samples, and the lights' light they bring.
-        let settings = (
-            options.specular_depth,
-            options.specular_rays,
-            options.seed,
-            threads,
-        );
         queries += if self.reporter.stopped() {
             transfer.direct.resize(n, DVec3::ZERO);
             transfer.specular_share.resize(n, 0.0);
             0
         } else {
-            transfer.follow(scene, solution, vis, (spec, lights), settings, first_new)?
+            transfer.follow(scene, solution, vis, (spec, lights), options, first_new)?
         };
         // The lights seen through two reflectors or more: taken whole, not interpolated.
         if let Some(far) = &self.far_light {
@@ -453,15 +441,9 @@ impl Solve<'_> {
             let (part, q) = if self.reporter.stopped() {
                 (vec![Arrival::default(); points.len()], 0)
             } else {
+                let exec = self.exec();
                 let mut report = self.reporter.part(base);
-                arrive(
-                    far,
-                    vis,
-                    self.ranks,
-                    at,
-                    (options.seed, threads),
-                    &mut report,
-                )?
+                arrive(far, vis, exec, at, &mut report)?
             };
             queries += q;
             transfer.far.extend(part.iter().map(|a| a.irradiance));
@@ -470,22 +452,8 @@ impl Solve<'_> {
         // their new areas make; new ones start from theirs (`warm`).
         if first_new == 0 && !self.reporter.stopped() {
             let base = self.base(Phase::Photons, round, n);
-            let settings = (
-                options.photons,
-                options.specular_depth,
-                options.seed,
-                threads,
-            );
             let mut report = self.reporter.part(base);
-            let budget = options.memory_budget;
-            queries += transfer.trace_photons(
-                scene,
-                vis,
-                (spec, lights),
-                settings,
-                budget,
-                &mut report,
-            )?;
+            queries += transfer.trace_photons(scene, vis, (spec, lights), options, &mut report)?;
         }
         let caustic = if transfer.landings.is_empty() || self.reporter.stopped() {
             let mut kept = transfer.caustic.clone();
@@ -526,8 +494,7 @@ impl Solve<'_> {
                 &solution.field.samples,
                 first_new,
                 self.vis,
-                (self.options.seed, self.options.threads.max(1)),
-                self.lift,
+                self.exec(),
                 &mut self.reporter.part(base),
             )?
         };
@@ -631,8 +598,7 @@ impl Solve<'_> {
             specular: solution.specular.as_ref(),
         };
         let settings = Settings {
-            ranks: self.ranks,
-            threads: options.threads.max(1),
+            exec: self.exec(),
             capacity: options.pipeline_capacity.max(1),
             tolerance: options.tolerance,
             max_shots: options.max_shots.unwrap_or(if hierarchical {
@@ -646,7 +612,6 @@ impl Solve<'_> {
             normalise: round == 0 || hierarchical,
             threshold: options.cluster_threshold,
             exact_visibility: options.exact_visibility,
-            seed: options.seed,
         };
         let mut link_seconds = None;
         let link_start = Instant::now();
@@ -703,24 +668,20 @@ impl Solve<'_> {
         let base = self.base(Phase::Adaptive, round, n);
         let refinement = adaptive::refine(
             &mut solution.field.samples,
-            solution.field.layout.maps(),
-            solution.field.layout.index(),
-            solution.field.layout.obstruction(),
+            &solution.field.layout,
             self.vis,
             &solution.field.radiosity,
             RefineSettings {
                 epsilon: self.epsilon,
                 zeta: options.zeta,
                 alpha: options.alpha,
-                threads: options.threads.max(1),
                 round: round as u16,
-                seed: options.seed,
                 // Half the budget for the samples, the rest for links and caches.
                 max_samples: options
                     .max_samples
                     .min(options.memory_budget / 2 / crate::budget::BYTES_PER_SAMPLE),
             },
-            self.ranks,
+            self.exec(),
             &mut self.reporter.part(base),
         )?;
         // A Stop heard while the errors were measured added nothing; one heard at their last

@@ -33,9 +33,9 @@ pub(crate) struct State<'a> {
 
 /// Settings of one solve.
 pub(crate) struct Settings<'a> {
-    /// The processes this solve is spread over ([`Single`](crate::distributed::Single) alone).
-    pub ranks: &'a dyn crate::distributed::Ranks,
-    pub threads: usize,
+    /// Threads, the seed of the hierarchy's visibility rays, and the processes this solve is
+    /// spread over ([`Single`](crate::distributed::Single) alone).
+    pub exec: crate::exec::Exec<'a>,
     /// Jobs in flight in the pipeline at most.
     pub capacity: usize,
     pub tolerance: f64,
@@ -51,8 +51,6 @@ pub(crate) struct Settings<'a> {
     pub threshold: f64,
     /// Refine every partly visible link of the hierarchy, however faint.
     pub exact_visibility: bool,
-    /// The seed of the hierarchy's visibility rays.
-    pub seed: u64,
 }
 
 /// What a shooting solver tells the solve between steps.

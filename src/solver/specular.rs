@@ -8,7 +8,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::Solution;
+use super::{Options, Solution};
 use crate::error::Result;
 use crate::field::interpolate::{Interpolator, Site};
 use crate::scene::Scene;
@@ -52,17 +52,19 @@ fn rgb(w: [f32; 3]) -> DVec3 {
 }
 
 impl Transfer {
-    /// Follows the chains of samples `first..` of `solution` and keeps their ends and direct
-    /// light; returns the queries.
+    /// Follows the chains of samples `first..` of `solution` (`options`' depth, rays a sample,
+    /// seed and threads) and keeps their ends and direct light; returns the queries.
     pub(crate) fn follow(
         &mut self,
         scene: &Scene,
         solution: &Solution,
         vis: &dyn Visibility,
         (spec, lights): (&Specular, &Lights),
-        (depth, rays, seed, threads): (u32, u32, u64, usize),
+        options: &Options,
         first: usize,
     ) -> Result<u64> {
+        let (depth, rays) = (options.specular_depth, options.specular_rays);
+        let (seed, threads) = (options.seed, options.threads);
         let s = &solution.field.samples;
         let n = s.len();
         let interpolator = Interpolator::new(scene, &solution.field, vis);
@@ -107,17 +109,23 @@ impl Transfer {
         Ok(queries)
     }
 
-    /// Sends the photons (where the scene needs them) and keeps their landings; the queries.
-    /// Landings that could pass a quarter of `budget` (bytes) are refused before any is traced.
+    /// Sends `options`' photons (where the scene needs them) and keeps their landings; the
+    /// queries. Landings that could pass a quarter of the memory budget are refused before any
+    /// is traced.
     pub(crate) fn trace_photons(
         &mut self,
         scene: &Scene,
         vis: &dyn Visibility,
         (spec, lights): (&Specular, &Lights),
-        (count, depth, seed, threads): (u64, u32, u64, usize),
-        budget: usize,
+        options: &Options,
         report: crate::parallel::Report,
     ) -> Result<u64> {
+        let (count, depth, budget) = (
+            options.photons,
+            options.specular_depth,
+            options.memory_budget,
+        );
+        let (seed, threads) = (options.seed, options.threads);
         let listing = crate::specular::images::chains(spec, depth);
         if !photons::needed(scene, spec, &listing) {
             return Ok(0);

@@ -48,20 +48,18 @@ pub(crate) fn exact_beyond_direct(solution: &Solution, k: usize) -> DVec3 {
 }
 
 /// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their
-/// unshot radiosity for a (warm) start: see the module doc. On up to `threads` threads, each
-/// rank a run of the new samples.
-#[allow(clippy::too_many_arguments)]
+/// unshot radiosity for a (warm) start: see the module doc. Each rank a run of the new samples.
 pub(crate) fn start(
     scene: &Scene,
     solution: &mut Solution,
     vis: &dyn Visibility,
     first_new: usize,
     arrivals: &[Arrival],
-    epsilon: f32,
     alpha: f32,
-    (threads, ranks): (usize, &dyn crate::distributed::Ranks),
+    exec: crate::exec::Exec,
 ) -> Result<()> {
     let n = solution.field.samples.len();
+    let epsilon = solution.field.layout.epsilon();
     // (irradiance, unshot, radiosity) of each new sample.
     let mut out = vec![(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); n - first_new];
     let shared: &Solution = solution;
@@ -118,10 +116,9 @@ pub(crate) fn start(
     };
     // Each rank a run of the new samples.
     crate::distributed::for_share(
-        ranks,
+        exec,
         &mut out,
         256,
-        threads,
         |first, out, _: &_| each(first, out),
         &mut |_| crate::progress::Control::Continue,
         |(h, u, b)| [h.x, h.y, h.z, u.x, u.y, u.z, b.x, b.y, b.z],

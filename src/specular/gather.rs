@@ -20,7 +20,7 @@ use super::lights::{LightSample, Lights};
 use super::shadow::{self, LightPath};
 use super::Specular;
 use crate::error::Result;
-use crate::material::{branches, Branches};
+use crate::material::{branches, Branches, Lobe};
 use crate::sampling::poisson::side_seed;
 use crate::sampling::{side_of, Side};
 use crate::scene::Scene;
@@ -289,7 +289,8 @@ impl Chains<'_> {
     }
 
     /// Follows `rays` chains from each receiver (point, normal, id: the seed of its random
-    /// numbers).
+    /// numbers), level by level (one batch of rays a level), and the light samples taken at
+    /// their glossy bounces.
     pub(crate) fn follow(&self, receivers: &[(Vec3, Vec3, u32)], seed: u64) -> Result<Found> {
         let mut found = Found {
             ends: Vec::new(),
@@ -297,8 +298,28 @@ impl Chains<'_> {
             specular_share: vec![0.0; receivers.len()],
             queries: 0,
         };
+        let mut level = self.first_links(receivers, seed);
+        let mut samples: Vec<(u32, Vec3, LightSample)> = Vec::new();
+        found.queries += self.highlight_samples(receivers, seed, &mut samples)?;
+        while !level.is_empty() {
+            level = self.next_level(&level, &mut found, &mut samples)?;
+        }
+        found.queries += self.glossy_light(&samples, &mut found.direct)?;
+        // By receiver (the levels came out depth by depth), in a fixed order.
+        found.ends.sort_by_key(|e| e.receiver);
+        Ok(found)
+    }
+
+    /// Each chain's weight at its start: the receiver's share of its `rays`.
+    fn share(&self) -> f64 {
+        1.0 / f64::from(self.rays.max(1))
+    }
+
+    /// The chains' first rays: `rays` a receiver, cosine-distributed on a Fibonacci lattice
+    /// shifted at random per receiver.
+    fn first_links(&self, receivers: &[(Vec3, Vec3, u32)], seed: u64) -> Vec<Link> {
         let k = self.rays.max(1);
-        let share = 1.0 / f64::from(k);
+        let share = self.share();
         let mut level: Vec<Link> = Vec::with_capacity(receivers.len() * k as usize);
         for (r, &(x, n, id)) in receivers.iter().enumerate() {
             let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 23));
@@ -331,182 +352,226 @@ impl Chains<'_> {
                 });
             }
         }
-        let mut samples: Vec<(u32, Vec3, LightSample)> = Vec::new();
-        found.queries += self.highlight_samples(receivers, seed, &mut samples)?;
+        level
+    }
+
+    /// Traces one level of links: what each hit ends or brings (into `found`, light samples
+    /// at glossy bounces into `samples`), and the links of the next level.
+    fn next_level(
+        &self,
+        level: &[Link],
+        found: &mut Found,
+        samples: &mut Vec<(u32, Vec3, LightSample)>,
+    ) -> Result<Vec<Link>> {
+        let rays: Vec<Ray> = level.iter().map(|l| l.ray).collect();
+        let mut hits = vec![None; rays.len()];
+        self.vis.intersect(&rays, &mut hits)?;
+        found.queries += rays.len() as u64;
+        let mut next = Vec::new();
         let mut scratch = Vec::new();
-        while !level.is_empty() {
-            let rays: Vec<Ray> = level.iter().map(|l| l.ray).collect();
-            let mut hits = vec![None; rays.len()];
-            self.vis.intersect(&rays, &mut hits)?;
-            found.queries += rays.len() as u64;
-            let mut next = Vec::new();
-            for (l, hit) in level.iter().zip(&hits) {
-                let Some(hit) = hit else { continue };
-                let tri = &self.scene.triangles[hit.triangle as usize];
-                let specular = self.spec.specular[tri.surface as usize];
-                // A chain starts at a specular surface: what is diffuse from the receiver is
-                // the links'.
-                if l.depth == 0 {
-                    if !specular {
-                        continue;
-                    }
-                    found.specular_share[l.receiver as usize] += share as f32;
-                }
-                let dir = l.ray.dir.normalize();
-                let back = dir.dot(tri.normal) > 0.0;
-                let side = side_of(tri.surface, back);
-                let point = l.ray.origin + hit.t * l.ray.dir;
-                let material = self.scene.material_of(tri.surface);
-                if l.depth > 0 {
-                    if (self.has_samples)(side) {
-                        found.ends.push(End {
-                            receiver: l.receiver,
-                            point,
-                            side,
-                            normal: if back { -tri.normal } else { tri.normal },
-                            weight: l.weight,
-                        });
-                    }
-                    if let Some(tree) = self.unlisted.filter(|_| !l.glossy) {
-                        if !back && material.is_emitter() && !(l.straight && tree.listed(l.node)) {
-                            found.direct[l.receiver as usize] +=
-                                std::f64::consts::PI * l.weight * material.ke.as_dvec3();
-                        }
-                    }
-                    if l.glossy && !back && material.is_emitter() {
-                        let mis = l.lobe_pdf.map_or(1.0, |pdf| {
-                            let dist2 = f64::from(hit.t * hit.t * l.ray.dir.length_squared());
-                            let cos_y = -f64::from(dir.dot(tri.normal));
-                            let third = l.first.map_or(0.0, |f| self.third(&f, point));
-                            self.lights.lobe_weight_with(
-                                tri.surface,
-                                pdf,
-                                (dist2, cos_y),
-                                (1, 1),
-                                third,
-                            )
-                        });
-                        found.direct[l.receiver as usize] +=
-                            std::f64::consts::PI * l.weight * material.ke.as_dvec3() * mis;
-                    }
-                }
-                if l.depth >= self.depth || !specular {
+        for (l, hit) in level.iter().zip(&hits) {
+            let Some(hit) = hit else { continue };
+            let tri = &self.scene.triangles[hit.triangle as usize];
+            let specular = self.spec.specular[tri.surface as usize];
+            // A chain starts at a specular surface: what is diffuse from the receiver is
+            // the links'.
+            if l.depth == 0 {
+                if !specular {
                     continue;
                 }
-                let two_sided = self.scene.surfaces[tri.surface as usize].two_sided;
-                let off = |d: DVec3| {
-                    let n = if d.dot(tri.normal.as_dvec3()) > 0.0 {
-                        tri.normal
-                    } else {
-                        -tri.normal
-                    };
-                    point + self.lift * n
-                };
-                match branches(material, dir.as_dvec3(), tri.normal.as_dvec3(), two_sided) {
-                    Branches::None => {}
-                    Branches::Delta(list) => {
-                        let all: f64 = list.iter().flatten().map(|(_, w)| w.max_element()).sum();
-                        for (j, (d, w)) in list.iter().flatten().enumerate() {
-                            let mut weight = l.weight * *w;
-                            if weight.max_element() < NEGLIGIBLE * share {
-                                continue;
-                            }
-                            // A faint branch (glass's reflection beside its refraction) goes on
-                            // at random, its weight raised by as much: a chain through a glass
-                            // ball would otherwise end at every one of its inner bounces.
-                            let kept = w.max_element() / (ROULETTE * all);
-                            if kept < 1.0 {
-                                let u = Pcg64Mcg::seed_from_u64(side_seed(l.rng, j as u32, 37))
-                                    .random::<f64>();
-                                if u >= kept {
-                                    continue;
-                                }
-                                weight /= kept;
-                            }
-                            // The first branch is the reflection, the second the
-                            // crossing (`material::branches`).
-                            let (straight, node) = self.carried(l, tri.surface, back, j == 0);
-                            next.push(Link {
-                                ray: Ray {
-                                    origin: off(*d),
-                                    dir: d.as_vec3(),
-                                    t_min: 0.0,
-                                    t_max: f32::INFINITY,
-                                },
-                                receiver: l.receiver,
-                                normal: l.normal,
-                                weight,
-                                depth: l.depth + 1,
-                                glossy: l.glossy,
-                                lobe_pdf: None,
-                                first: None,
-                                rng: side_seed(l.rng, j as u32, 31),
-                                straight,
-                                node,
-                            });
-                        }
-                    }
-                    Branches::Glossy(lobe) => {
-                        let mut rng = Pcg64Mcg::seed_from_u64(l.rng);
-                        let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
-                        let from = point + self.lift * lobe.normal().as_vec3();
-                        // A first bounce on a glossy plane weighs against highlight sampling.
-                        let first = match self.highlights.plane_of(tri.surface) {
-                            Some(plane) if l.depth == 0 => Some(FirstBounce {
-                                x: l.ray.origin,
-                                cos_x: f64::from(l.normal.dot(dir)),
-                                omega: dir.as_dvec3(),
-                                plane: plane.surface,
-                            }),
-                            _ => None,
-                        };
-                        scratch.clear();
-                        let third = |light: Vec3, density: Option<f64>| match first {
-                            Some(f) => self.third(&f, light) * density.unwrap_or(1.0),
-                            None => 0.0,
-                        };
-                        self.lights.sample_with(
-                            &lobe,
-                            from,
-                            (1, 1),
-                            &mut uniforms,
-                            &third,
-                            &mut scratch,
-                        );
-                        for mut sample in scratch.drain(..) {
-                            sample.radiance *= std::f64::consts::PI * l.weight;
-                            samples.push((l.receiver, from, sample));
-                        }
-                        let (u1, u2) = uniforms();
-                        if let Some((d, w)) = lobe.sample(u1, u2) {
-                            let weight = l.weight * w;
-                            if weight.max_element() >= NEGLIGIBLE * share {
-                                next.push(Link {
-                                    ray: Ray {
-                                        origin: from,
-                                        dir: d.as_vec3(),
-                                        t_min: 0.0,
-                                        t_max: f32::INFINITY,
-                                    },
-                                    receiver: l.receiver,
-                                    normal: l.normal,
-                                    weight,
-                                    depth: l.depth + 1,
-                                    glossy: true,
-                                    lobe_pdf: Some(lobe.pdf(d)),
-                                    first,
-                                    rng: side_seed(l.rng, 7, 37),
-                                    straight: false,
-                                    node: ChainTree::OFF,
-                                });
-                            }
-                        }
-                    }
+                found.specular_share[l.receiver as usize] += self.share() as f32;
+            }
+            let at = At {
+                tri,
+                dir: l.ray.dir.normalize(),
+                point: l.ray.origin + hit.t * l.ray.dir,
+                t: hit.t,
+            };
+            if l.depth > 0 {
+                self.arrive(l, &at, found);
+            }
+            if l.depth >= self.depth || !specular {
+                continue;
+            }
+            let material = self.scene.material_of(tri.surface);
+            let two_sided = self.scene.surfaces[tri.surface as usize].two_sided;
+            let (dir, normal) = (at.dir.as_dvec3(), tri.normal.as_dvec3());
+            match branches(material, dir, normal, two_sided) {
+                Branches::None => {}
+                Branches::Delta(list) => self.delta_branches(l, &at, &list, &mut next),
+                Branches::Glossy(lobe) => {
+                    self.glossy_branch(l, &at, &lobe, &mut next, samples, &mut scratch)
                 }
             }
-            level = next;
         }
-        // The light samples taken at glossy bounces, where nothing blocks them.
+        Ok(next)
+    }
+
+    /// What a link that reached a surface brings: an end where the surface has samples (its
+    /// light is interpolated there), and an emitter's light where the images do not carry the
+    /// path, or where a glossy bounce saw it (weighed against the light samples).
+    fn arrive(&self, l: &Link, at: &At, found: &mut Found) {
+        let tri = at.tri;
+        let back = at.dir.dot(tri.normal) > 0.0;
+        let side = side_of(tri.surface, back);
+        let material = self.scene.material_of(tri.surface);
+        if (self.has_samples)(side) {
+            found.ends.push(End {
+                receiver: l.receiver,
+                point: at.point,
+                side,
+                normal: if back { -tri.normal } else { tri.normal },
+                weight: l.weight,
+            });
+        }
+        if let Some(tree) = self.unlisted.filter(|_| !l.glossy) {
+            if !back && material.is_emitter() && !(l.straight && tree.listed(l.node)) {
+                found.direct[l.receiver as usize] +=
+                    std::f64::consts::PI * l.weight * material.ke.as_dvec3();
+            }
+        }
+        if l.glossy && !back && material.is_emitter() {
+            let mis = l.lobe_pdf.map_or(1.0, |pdf| {
+                let dist2 = f64::from(at.t * at.t * l.ray.dir.length_squared());
+                let cos_y = -f64::from(at.dir.dot(tri.normal));
+                let third = l.first.map_or(0.0, |f| self.third(&f, at.point));
+                self.lights
+                    .lobe_weight_with(tri.surface, pdf, (dist2, cos_y), (1, 1), third)
+            });
+            found.direct[l.receiver as usize] +=
+                std::f64::consts::PI * l.weight * material.ke.as_dvec3() * mis;
+        }
+    }
+
+    /// The point just off the surface hit, on the side direction `d` leaves to.
+    fn off(&self, at: &At, d: DVec3) -> Vec3 {
+        let n = if d.dot(at.tri.normal.as_dvec3()) > 0.0 {
+            at.tri.normal
+        } else {
+            -at.tri.normal
+        };
+        at.point + self.lift * n
+    }
+
+    /// A mirror's or glass's branches as links of the next level; a faint branch (glass's
+    /// reflection beside its refraction) goes on at random, its weight raised by as much: a
+    /// chain through a glass ball would otherwise end at every one of its inner bounces.
+    fn delta_branches(
+        &self,
+        l: &Link,
+        at: &At,
+        list: &[Option<(DVec3, DVec3)>],
+        next: &mut Vec<Link>,
+    ) {
+        let share = self.share();
+        let back = at.dir.dot(at.tri.normal) > 0.0;
+        let all: f64 = list.iter().flatten().map(|(_, w)| w.max_element()).sum();
+        for (j, (d, w)) in list.iter().flatten().enumerate() {
+            let mut weight = l.weight * *w;
+            if weight.max_element() < NEGLIGIBLE * share {
+                continue;
+            }
+            let kept = w.max_element() / (ROULETTE * all);
+            if kept < 1.0 {
+                let u = Pcg64Mcg::seed_from_u64(side_seed(l.rng, j as u32, 37)).random::<f64>();
+                if u >= kept {
+                    continue;
+                }
+                weight /= kept;
+            }
+            // The first branch is the reflection, the second the crossing
+            // (`material::branches`).
+            let (straight, node) = self.carried(l, at.tri.surface, back, j == 0);
+            next.push(Link {
+                ray: Ray {
+                    origin: self.off(at, *d),
+                    dir: d.as_vec3(),
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                },
+                receiver: l.receiver,
+                normal: l.normal,
+                weight,
+                depth: l.depth + 1,
+                glossy: l.glossy,
+                lobe_pdf: None,
+                first: None,
+                rng: side_seed(l.rng, j as u32, 31),
+                straight,
+                node,
+            });
+        }
+    }
+
+    /// A glossy bounce: light samples towards the lights (kept in `samples`, traced together
+    /// at the end) and one link drawn from the lobe.
+    fn glossy_branch(
+        &self,
+        l: &Link,
+        at: &At,
+        lobe: &Lobe,
+        next: &mut Vec<Link>,
+        samples: &mut Vec<(u32, Vec3, LightSample)>,
+        scratch: &mut Vec<LightSample>,
+    ) {
+        let mut rng = Pcg64Mcg::seed_from_u64(l.rng);
+        let mut uniforms = || (rng.random::<f64>(), rng.random::<f64>());
+        let from = at.point + self.lift * lobe.normal().as_vec3();
+        // A first bounce on a glossy plane weighs against highlight sampling.
+        let first = match self.highlights.plane_of(at.tri.surface) {
+            Some(plane) if l.depth == 0 => Some(FirstBounce {
+                x: l.ray.origin,
+                cos_x: f64::from(l.normal.dot(at.dir)),
+                omega: at.dir.as_dvec3(),
+                plane: plane.surface,
+            }),
+            _ => None,
+        };
+        scratch.clear();
+        let third = |light: Vec3, density: Option<f64>| match first {
+            Some(f) => self.third(&f, light) * density.unwrap_or(1.0),
+            None => 0.0,
+        };
+        self.lights
+            .sample_with(lobe, from, (1, 1), &mut uniforms, &third, scratch);
+        for mut sample in scratch.drain(..) {
+            sample.radiance *= std::f64::consts::PI * l.weight;
+            samples.push((l.receiver, from, sample));
+        }
+        let (u1, u2) = uniforms();
+        let Some((d, w)) = lobe.sample(u1, u2) else {
+            return;
+        };
+        let weight = l.weight * w;
+        if weight.max_element() >= NEGLIGIBLE * self.share() {
+            next.push(Link {
+                ray: Ray {
+                    origin: from,
+                    dir: d.as_vec3(),
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                },
+                receiver: l.receiver,
+                normal: l.normal,
+                weight,
+                depth: l.depth + 1,
+                glossy: true,
+                lobe_pdf: Some(lobe.pdf(d)),
+                first,
+                rng: side_seed(l.rng, 7, 37),
+                straight: false,
+                node: ChainTree::OFF,
+            });
+        }
+    }
+
+    /// The light samples taken at glossy bounces, added to their receivers' direct light where
+    /// nothing blocks them; the queries.
+    fn glossy_light(
+        &self,
+        samples: &[(u32, Vec3, LightSample)],
+        direct: &mut [DVec3],
+    ) -> Result<u64> {
         let paths: Vec<LightPath> = samples
             .iter()
             .map(|(_, from, s)| LightPath {
@@ -516,12 +581,20 @@ impl Chains<'_> {
             })
             .collect();
         let mut shares = vec![DVec3::ZERO; paths.len()];
-        found.queries += shadow::arriving(self.spec, self.vis, self.lift, &paths, &mut shares)?;
+        let queries = shadow::arriving(self.spec, self.vis, self.lift, &paths, &mut shares)?;
         for ((receiver, _, s), share) in samples.iter().zip(shares) {
-            found.direct[*receiver as usize] += s.radiance * share;
+            direct[*receiver as usize] += s.radiance * share;
         }
-        // By receiver (the levels came out depth by depth), in a fixed order.
-        found.ends.sort_by_key(|e| e.receiver);
-        Ok(found)
+        Ok(queries)
     }
+}
+
+/// Where a link met a surface.
+struct At<'s> {
+    tri: &'s crate::scene::Triangle,
+    /// The link's direction, normalised.
+    dir: Vec3,
+    point: Vec3,
+    /// The hit's ray parameter.
+    t: f32,
 }

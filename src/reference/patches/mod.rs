@@ -123,9 +123,7 @@ pub fn patch_radiosity(
             state,
             vis,
             lift,
-            options.threads,
-            options.tolerance,
-            options.max_shots,
+            options,
             &mut |shots, unshot_fraction| {
                 // The share of the way on a log scale: unshot power falls about geometrically.
                 let fraction =

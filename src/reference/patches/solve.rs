@@ -132,19 +132,17 @@ pub(crate) fn point_lights(
     Ok(queries.into_inner())
 }
 
-/// Shoots until the unshot power falls below `tolerance` × the power there was to shoot at
-/// the start, or `max_shots`, or the host says stop.
-#[allow(clippy::too_many_arguments)]
+/// Shoots until the unshot power falls below `options.tolerance` × the power there was to shoot
+/// at the start, or `options.max_shots`, or the host says stop; on `options.threads`.
 pub(crate) fn shoot(
     patches: &[Patch],
     mut state: Vec<PatchState>,
     vis: &dyn Visibility,
     lift: f32,
-    threads: usize,
-    tolerance: f64,
-    max_shots: u64,
+    options: &super::PatchOptions,
     report: &mut dyn FnMut(u64, f64) -> Control,
 ) -> Result<Shooting> {
+    let (threads, tolerance, max_shots) = (options.threads, options.tolerance, options.max_shots);
     let n = patches.len();
     let memo = Memo::new(n);
     let power = |s: &PatchState, p: &Patch| luminance(s.unshot) * p.area;

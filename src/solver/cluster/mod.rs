@@ -31,7 +31,7 @@ use self::links::{Linker, Links};
 use self::sweep::{shooters, Shooter, Sources};
 use self::tree::{Ref, Tree};
 use super::normalise::row_scale;
-use super::pipeline::with_pool;
+use super::pipeline::{with_pool, Pool};
 use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
 use crate::distributed::{gather_one, owners, sum_over, Ranks};
@@ -100,7 +100,7 @@ pub(crate) fn shoot(
     }
 
     let (tree, groups, flow) = tree_and_links(state, vis, settings, cx, &mut stats, report)?;
-    let ranks = settings.ranks;
+    let ranks = settings.exec.ranks;
     // Each rank gives 3 values a sample of its groups to every sweep's exchange.
     let mut counts = vec![0usize; ranks.size().max(1)];
     for g in &groups {
@@ -125,16 +125,17 @@ pub(crate) fn shoot(
         stats.bytes = link_bytes as u64;
         return Ok(stats);
     }
-    let (groups, _) = sweep(
-        state, &tree, groups, &counts, settings, &mut stats, report, None,
-    )?;
-    let delivered: usize = groups
+    let mut linked = Linked::new(tree, groups, counts);
+    sweep(state, &mut linked, settings, &mut stats, report)?;
+    let delivered: usize = linked
+        .groups
         .iter()
         .map(|g| g.delivered.capacity() * std::mem::size_of::<DVec3>())
         .sum();
+    let nodes = linked.tree.nodes.len();
     stats.bytes = (link_bytes
         + delivered
-        + tree.nodes.len() * (std::mem::size_of::<tree::Node>() + std::mem::size_of::<Shooter>()))
+        + nodes * (std::mem::size_of::<tree::Node>() + std::mem::size_of::<Shooter>()))
         as u64;
     Ok(stats)
 }
@@ -167,7 +168,7 @@ fn tree_and_links(
         lift: settings.lift,
         tolerance: settings.threshold * reference,
         faint_links: !settings.exact_visibility,
-        seed: settings.seed,
+        seed: settings.exec.seed,
         halt: &std::sync::atomic::AtomicBool::new(false),
     };
     let room = link_room(settings.memory_bytes, tree.nodes.len());
@@ -176,7 +177,7 @@ fn tree_and_links(
 }
 
 /// One tree and its links with their row sums, kept to shoot many lightings of the same
-/// samples (`solver::basis`): sweeps only, no linking, for each.
+/// samples (`solver::basis`): sweeps only, no linking, for each. A single solve sweeps one too.
 pub(crate) struct Linked {
     tree: Tree,
     groups: Vec<Group>,
@@ -185,6 +186,21 @@ pub(crate) struct Linked {
     rows: Vec<f64>,
     links: u64,
     leaf_links: u64,
+}
+
+impl Linked {
+    /// The tree and its groups of links, `counts` what each rank gives to a sweep's exchange;
+    /// no row sums yet.
+    fn new(tree: Tree, groups: Vec<Group>, counts: Vec<usize>) -> Linked {
+        Linked {
+            tree,
+            groups,
+            counts,
+            rows: Vec::new(),
+            links: 0,
+            leaf_links: 0,
+        }
+    }
 }
 
 /// Builds the tree and links for `state`'s samples, its shooters weighed by
@@ -213,17 +229,11 @@ pub(crate) fn link(
         max_shots: 0,
         ..*settings
     };
-    let (groups, rows) = sweep(
-        state, &tree, groups, &counts, &rows_only, &mut stats, report, None,
-    )?;
-    Ok(Some(Linked {
-        tree,
-        groups,
-        counts,
-        rows,
-        links: stats.links,
-        leaf_links: stats.leaf_links,
-    }))
+    let mut linked = Linked::new(tree, groups, counts);
+    sweep(state, &mut linked, &rows_only, &mut stats, report)?;
+    linked.links = stats.links;
+    linked.leaf_links = stats.leaf_links;
+    Ok(Some(linked))
 }
 
 /// Shoots `state` along `linked`'s links until converged (the row scales in `state` are those
@@ -244,20 +254,7 @@ pub(crate) fn shoot_along(
         normalise: false,
         ..*settings
     };
-    let groups = std::mem::take(&mut linked.groups);
-    let rows = std::mem::take(&mut linked.rows);
-    let (groups, _) = sweep(
-        state,
-        &linked.tree,
-        groups,
-        &linked.counts,
-        &settings,
-        &mut stats,
-        report,
-        Some(&rows),
-    )?;
-    linked.groups = groups;
-    linked.rows = rows;
+    sweep(state, linked, &settings, &mut stats, report)?;
     Ok(stats)
 }
 
@@ -318,8 +315,8 @@ fn link_groups(
     stats: &mut ShootStats,
     report: &mut dyn FnMut(Tick) -> Control,
 ) -> Result<(Vec<Group>, ControlFlow<()>)> {
-    let threads = settings.threads.max(1);
-    let ranks = settings.ranks;
+    let threads = settings.exec.threads.max(1);
+    let ranks = settings.exec.ranks;
     let (me, size) = (ranks.rank(), ranks.size().max(1));
     let pairs: Vec<(usize, usize)> = (0..roots.len())
         .flat_map(|x| (x..roots.len()).map(move |y| (x, y)))
@@ -439,28 +436,27 @@ fn share_groups(ranks: &dyn Ranks, parts: &[Vec<(u32, Links)>]) -> Result<Vec<us
     Ok(owners(&weight, size))
 }
 
-/// The row sums (one sweep with unit radiosity, when asked), then sweeps until the unshot
-/// power is below the tolerance, the sweeps run out, or the host stops; the groups back.
-/// `counts`: what each rank gives to a sweep's exchange. `given`: row sums found before (for
-/// the balance), where the sweeps do not find them; the groups and the row sums back.
-#[allow(clippy::too_many_arguments)]
+/// The row sums (one sweep with unit radiosity, when the settings ask: into `linked.rows`),
+/// then sweeps along `linked`'s groups until the unshot power is below the tolerance, the
+/// sweeps run out, or the host stops. Row sums found before (for the balance) stay in
+/// `linked.rows` where the sweeps do not find them.
 fn sweep(
     state: &mut State,
-    tree: &Tree,
-    mut groups: Vec<Group>,
-    counts: &[usize],
+    linked: &mut Linked,
     settings: &Settings,
     stats: &mut ShootStats,
     report: &mut dyn FnMut(Tick) -> Control,
-    given: Option<&[f64]>,
-) -> Result<(Vec<Group>, Vec<f64>)> {
+) -> Result<()> {
+    let (tree, counts) = (&linked.tree, linked.counts.as_slice());
+    let mut groups = std::mem::take(&mut linked.groups);
+    let given = std::mem::take(&mut linked.rows);
     let samples = state.samples;
     let n = samples.len();
     let emitted = state.ledger.emitted.element_sum();
     // What every group's sweep reads: written by the coordinator between sweeps, read by the
     // workers during them.
     let inputs = RwLock::new(Inputs::default());
-    let ranks = settings.ranks;
+    let ranks = settings.exec.ranks;
     let work = |mut group: Group| -> Result<Group> {
         if !group.owned {
             // Another rank's: its deliveries come in the exchange.
@@ -493,143 +489,208 @@ fn sweep(
         inputs.scales.clear();
         inputs.scales.extend_from_slice(scales);
     };
-    with_pool(settings.threads.max(1), settings.capacity, &work, |pool| {
-        // Row sums: one sweep with unit radiosity everywhere, unscaled. Each sample's normalised
-        // row sum is by reciprocity also the share of what it shoots that the links should
-        // deliver (see `balance`).
-        let mut rows = given.map_or_else(Vec::new, <[f64]>::to_vec);
-        if settings.normalise {
-            set(&vec![DVec3::ONE; n], &[]);
-            let mut kept = Vec::with_capacity(groups.len());
-            let mut sums = vec![0.0f64; n];
-            pool.run_all(groups.drain(..), |_, group| {
-                kept.push(group);
-                Ok(())
-            })?;
-            groups = kept;
-            stats.exchanged_bytes += exchange(&mut groups, tree, ranks, counts)?;
-            for group in &groups {
-                let first = first_member(tree, group.root);
-                for (p, h) in group.delivered.iter().enumerate() {
-                    sums[tree.order[first + p] as usize] = h.x;
-                }
-            }
-            for (i, scale) in state.row_scale.iter_mut().enumerate() {
-                *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
-            }
-            // Only cluster links need it: with sample-to-sample links alone (threshold 0) the
-            // transport is the flat solver's, and stays so.
-            if stats.links > stats.leaf_links {
-                rows = sums
-                    .iter()
-                    .zip(state.row_scale.iter())
-                    .map(|(&sum, &scale)| sum * f64::from(scale))
-                    .collect();
-            }
-        }
-
-        let max_sweeps = if settings.max_shots == u64::MAX {
-            MAX_SWEEPS
-        } else {
-            settings.max_shots
-        };
-        let mut first = true;
-        let mut last_shot = None;
-        loop {
-            let total: f64 = (0..n)
-                .map(|k| unshot_power(state.unshot[k], samples.area[k]))
-                .sum();
-            stats.unshot_fraction = total / emitted;
-            if first {
-                stats.initial_unshot_fraction = stats.unshot_fraction;
-                first = false;
-            }
-            if stats.unshot_fraction.is_nan() || stats.unshot_fraction >= 1e6 {
-                stats.stop = StopReason::Diverged;
-                break;
-            }
-            if stats.unshot_fraction < settings.tolerance || total == 0.0 {
-                stats.stop = StopReason::Converged;
-                break;
-            }
-            if stats.shots >= max_sweeps {
-                stats.stop = StopReason::ShotLimit;
-                break;
-            }
-            let stop = report(Tick::shooting(
-                stats.shots,
-                stats.unshot_fraction,
-                stats.initial_unshot_fraction,
-                settings.tolerance,
-            )) == Control::Stop;
-            if crate::distributed::any(ranks, stop)? {
-                stats.stop = StopReason::Stopped;
-                break;
-            }
-
-            // Every sample shoots its unshot radiosity along the links.
-            set(state.unshot, state.row_scale);
-            let shot: DVec3 = (0..n).map(|k| state.unshot[k] * samples.area[k]).sum();
-            let owed: DVec3 = if rows.is_empty() {
-                DVec3::ZERO
-            } else {
-                (0..n)
-                    .map(|k| state.unshot[k] * (samples.area[k] * rows[k]))
-                    .sum()
+    let rows = with_pool(
+        settings.exec.threads.max(1),
+        settings.capacity,
+        &work,
+        |pool| {
+            let mut sweeps = Sweeps {
+                pool,
+                tree,
+                ranks,
+                counts,
             };
-            let mut delivered = DVec3::ZERO;
-            let mut kept = Vec::with_capacity(groups.len());
-            pool.run_all(groups.drain(..), |_, group| {
-                kept.push(group);
-                Ok(())
-            })?;
-            groups = kept;
-            stats.exchanged_bytes += exchange(&mut groups, tree, ranks, counts)?;
-            for group in &groups {
-                let first = first_member(tree, group.root);
-                for (p, &h) in group.delivered.iter().enumerate() {
-                    delivered += h * samples.area[tree.order[first + p] as usize];
+            // Row sums: one sweep with unit radiosity everywhere, unscaled. Each sample's
+            // normalised row sum is by reciprocity also the share of what it shoots that the
+            // links should deliver (see `balance`).
+            let mut rows = given;
+            if settings.normalise {
+                if let Some(sums) = row_sums(&mut sweeps, &mut groups, state, stats, &set)? {
+                    rows = sums;
                 }
             }
-            let factor = if rows.is_empty() {
-                DVec3::ONE
+            let max_sweeps = if settings.max_shots == u64::MAX {
+                MAX_SWEEPS
             } else {
-                balance(owed, delivered)
+                settings.max_shots
             };
-            delivered *= factor;
-            let (irradiance, unshot) = (&mut *state.irradiance, &mut *state.unshot);
-            let reflectance = state.reflectance;
-            for group in &groups {
-                let first = first_member(tree, group.root);
-                for (p, &h) in group.delivered.iter().enumerate() {
-                    let k = tree.order[first + p] as usize;
-                    let h = h * factor;
-                    irradiance[k] += h;
-                    unshot[k] = reflectance[k] * h;
+            let mut first = true;
+            let mut last_shot = None;
+            loop {
+                let total: f64 = (0..n)
+                    .map(|k| unshot_power(state.unshot[k], samples.area[k]))
+                    .sum();
+                stats.unshot_fraction = total / emitted;
+                if first {
+                    stats.initial_unshot_fraction = stats.unshot_fraction;
+                    first = false;
+                }
+                if let Some(stop) = settled(stats, settings, total, max_sweeps) {
+                    stats.stop = stop;
+                    break;
+                }
+                let stop = report(Tick::shooting(
+                    stats.shots,
+                    stats.unshot_fraction,
+                    stats.initial_unshot_fraction,
+                    settings.tolerance,
+                )) == Control::Stop;
+                if crate::distributed::any(ranks, stop)? {
+                    stats.stop = StopReason::Stopped;
+                    break;
+                }
+                let shot =
+                    shoot_once(&mut sweeps, &mut groups, state, &rows, &set, &inputs, stats)?;
+                stats.shots += 1;
+                last_shot = Some(shot);
+            }
+            if stats.stop == StopReason::Converged {
+                if let Some(shot) = last_shot {
+                    tail(state, shot);
                 }
             }
-            // And by way of specular surfaces: G applied to what was shot.
-            if let Some(g) = state.specular {
-                let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
-                for k in 0..n {
-                    let h = g.row_times(k, &inputs.unshot);
-                    irradiance[k] += h;
-                    unshot[k] += reflectance[k] * h;
-                    delivered += h * samples.area[k];
-                }
-            }
-            state.ledger.escaped += shot - delivered;
-            stats.shots += 1;
-            last_shot = Some(shot);
+            Ok(rows)
+        },
+    )?;
+    linked.groups = groups;
+    linked.rows = rows;
+    Ok(())
+}
+
+/// The groups' sweeps on the pipeline's workers, and their deliveries swapped between ranks.
+struct Sweeps<'p, 'w, 'a> {
+    pool: &'p mut Pool<'w, Group, Group>,
+    tree: &'a Tree,
+    ranks: &'a dyn Ranks,
+    /// What each rank gives to an exchange.
+    counts: &'a [usize],
+}
+
+impl Sweeps<'_, '_, '_> {
+    /// One sweep of every group (each gathers what its links deliver), in order; the bytes the
+    /// exchange moved.
+    fn run(&mut self, groups: &mut Vec<Group>) -> Result<u64> {
+        let mut kept = Vec::with_capacity(groups.len());
+        self.pool.run_all(groups.drain(..), |_, group| {
+            kept.push(group);
+            Ok(())
+        })?;
+        *groups = kept;
+        exchange(groups, self.tree, self.ranks, self.counts)
+    }
+}
+
+/// The row sums: one sweep with unit radiosity everywhere, unscaled, which sets each
+/// receiver's row scale (`normalise`); the normalised sums where cluster links need them for
+/// the balance (with sample-to-sample links alone, threshold 0, the transport is the flat
+/// solver's, and stays so).
+fn row_sums(
+    sweeps: &mut Sweeps,
+    groups: &mut Vec<Group>,
+    state: &mut State,
+    stats: &mut ShootStats,
+    set: &dyn Fn(&[DVec3], &[f32]),
+) -> Result<Option<Vec<f64>>> {
+    let (tree, n) = (sweeps.tree, state.samples.len());
+    set(&vec![DVec3::ONE; n], &[]);
+    let mut sums = vec![0.0f64; n];
+    stats.exchanged_bytes += sweeps.run(groups)?;
+    for group in groups.iter() {
+        let first = first_member(tree, group.root);
+        for (p, h) in group.delivered.iter().enumerate() {
+            sums[tree.order[first + p] as usize] = h.x;
         }
-        if stats.stop == StopReason::Converged {
-            if let Some(shot) = last_shot {
-                tail(state, shot);
-            }
+    }
+    for (i, scale) in state.row_scale.iter_mut().enumerate() {
+        *scale = row_scale(sums[i], state.closed[i], state.dark_emitters[i]);
+    }
+    Ok((stats.links > stats.leaf_links).then(|| {
+        sums.iter()
+            .zip(state.row_scale.iter())
+            .map(|(&sum, &scale)| sum * f64::from(scale))
+            .collect()
+    }))
+}
+
+/// Why the sweeps end before the next, if they do: diverged, converged (the unshot power
+/// `total` below the tolerance), or out of sweeps.
+fn settled(
+    stats: &ShootStats,
+    settings: &Settings,
+    total: f64,
+    max_sweeps: u64,
+) -> Option<StopReason> {
+    if stats.unshot_fraction.is_nan() || stats.unshot_fraction >= 1e6 {
+        Some(StopReason::Diverged)
+    } else if stats.unshot_fraction < settings.tolerance || total == 0.0 {
+        Some(StopReason::Converged)
+    } else if stats.shots >= max_sweeps {
+        Some(StopReason::ShotLimit)
+    } else {
+        None
+    }
+}
+
+/// One sweep: every sample shoots its unshot radiosity along the links (and by way of specular
+/// surfaces), each receiver's delivery balanced against what its shooters owe (`rows`, where
+/// given); the power shot.
+fn shoot_once(
+    sweeps: &mut Sweeps,
+    groups: &mut Vec<Group>,
+    state: &mut State,
+    rows: &[f64],
+    set: &dyn Fn(&[DVec3], &[f32]),
+    inputs: &RwLock<Inputs>,
+    stats: &mut ShootStats,
+) -> Result<DVec3> {
+    let (tree, samples) = (sweeps.tree, state.samples);
+    let n = samples.len();
+    set(state.unshot, state.row_scale);
+    let shot: DVec3 = (0..n).map(|k| state.unshot[k] * samples.area[k]).sum();
+    let owed: DVec3 = if rows.is_empty() {
+        DVec3::ZERO
+    } else {
+        (0..n)
+            .map(|k| state.unshot[k] * (samples.area[k] * rows[k]))
+            .sum()
+    };
+    let mut delivered = DVec3::ZERO;
+    stats.exchanged_bytes += sweeps.run(groups)?;
+    for group in groups.iter() {
+        let first = first_member(tree, group.root);
+        for (p, &h) in group.delivered.iter().enumerate() {
+            delivered += h * samples.area[tree.order[first + p] as usize];
         }
-        Ok(rows)
-    })
-    .map(|rows| (groups, rows))
+    }
+    let factor = if rows.is_empty() {
+        DVec3::ONE
+    } else {
+        balance(owed, delivered)
+    };
+    delivered *= factor;
+    let (irradiance, unshot) = (&mut *state.irradiance, &mut *state.unshot);
+    let reflectance = state.reflectance;
+    for group in groups.iter() {
+        let first = first_member(tree, group.root);
+        for (p, &h) in group.delivered.iter().enumerate() {
+            let k = tree.order[first + p] as usize;
+            let h = h * factor;
+            irradiance[k] += h;
+            unshot[k] = reflectance[k] * h;
+        }
+    }
+    // And by way of specular surfaces: G applied to what was shot.
+    if let Some(g) = state.specular {
+        let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
+        for k in 0..n {
+            let h = g.row_times(k, &inputs.unshot);
+            irradiance[k] += h;
+            unshot[k] += reflectance[k] * h;
+            delivered += h * samples.area[k];
+        }
+    }
+    state.ledger.escaped += shot - delivered;
+    Ok(shot)
 }
 
 /// Reflections beyond this share per sweep are not extrapolated (the tail's factor r/(1 − r)
