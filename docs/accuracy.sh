@@ -1,46 +1,47 @@
 #!/bin/bash
-# Re-measures docs/accuracy.md: path-traced references, the bias table, the knob table and the
-# sweeps. Takes about 45 minutes on 2 cores, the references most of it (OUT_DIR keeps them).
-# Usage: docs/accuracy.sh OUT_DIR [OLD_BINARY]   (OLD_BINARY: a build of ba22335 for "before")
+# Re-measures docs/accuracy.md: path-traced references, the defaults scene by scene (and the
+# high-albedo bias over ten seeds), the knob table and the sweeps. About 45 minutes on 2
+# cores, the references most of it (OUT_DIR keeps them).
+# Usage: docs/accuracy.sh OUT_DIR
 set -euo pipefail
-OUT=${1:?usage: docs/accuracy.sh OUT_DIR [OLD_BINARY]}
-OLD=${2:-}
+OUT=${1:?usage: docs/accuracy.sh OUT_DIR}
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 cargo build --release --manifest-path "$ROOT/Cargo.toml"
 [ -f "$ROOT/scenes/gallery/gallery.obj" ] || (cd "$ROOT" && cargo run --release -p meshlight-gallery)
 M="$ROOT/target/release/meshlight"
 mkdir -p "$OUT" && cd "$OUT"
 
-# Scene variants: `room` and `cornell` at 256² (room95s: 128²), their whites at Kd 0.85 / 0.95;
-# the gallery at 192×128.
+# Scene variants: `room` at 256², `room` and `cornell` at 128² with their whites at their own Kd
+# or 0.95; the gallery at 192×128.
 variant() { # name source-dir kd width height
   mkdir -p "$1" && cp "$ROOT/scenes/$2"/*.{obj,mtl,toml} "$1/"
   sed -i "s/^width = .*/width = $4/; s/^height = .*/height = $5/" "$1/scene.toml"
   [ "$3" = "-" ] || sed -i "/newmtl white/,/^Kd/ s/^Kd .*/Kd $3 $3 $3/" "$1"/*.mtl
 }
 variant room room - 256 256
-variant room85 room 0.85 256 256
-variant room95 room 0.95 256 256
 variant room95s room 0.95 128 128
-variant cornell cornell - 256 256
-variant cornell95 cornell 0.95 256 256
+variant cornells cornell - 128 128
+variant cornell95s cornell 0.95 128 128
 mkdir -p gallery && cp "$ROOT/scenes/gallery/scene.toml" gallery/
 ln -sf "$ROOT/scenes/gallery/gallery.obj" "$ROOT/scenes/gallery/gallery.mtl" gallery/
 sed -i "s/^width = .*/width = 192/; s/^height = .*/height = 128/" gallery/scene.toml
 
 # References (kept when OUT_DIR already holds them: they do not depend on the solver).
 ref() { [ -f "ref_$1.exr" ] && return; "$M" render "$1/scene.toml" --method pathtrace --spp "$2" -o "ref_$1.exr" > "ref_$1.log" 2>/dev/null; }
-ref room 8192; ref room85 2048; ref room95 4096; ref room95s 40000
-ref cornell 1024; ref cornell95 1024; ref gallery 16384
+ref room 8192; ref room95s 16384; ref cornells 8192; ref cornell95s 8192; ref gallery 16384
 
-# Bias before (OLD), now (hierarchy, the default) and flat.
-: > bias.txt
-for s in room95s room room85 room95 cornell cornell95; do
-  for v in old new flat; do
-    case $v in old) [ -n "$OLD" ] || continue; B=$OLD; X="";; new) B=$M; X="";; flat) B=$M; X="--cluster-threshold 0";; esac
-    $B render "$s/scene.toml" $X -o "${v}_$s.exr" > "${v}_$s.log" 2>/dev/null
-    echo "== $s $v: $(grep -E '^total' "${v}_$s.log")" >> bias.txt
-    "$M" compare "${v}_$s.exr" "ref_$s.exr" >> bias.txt
+# The defaults, scene by scene, over 4 × 4 blocks; at Kd 0.95 the bias over seeds 1-10.
+: > defaults.txt
+for s in room room95s cornells cornell95s gallery; do
+  "$M" render "$s/scene.toml" -o "now_$s.exr" > "now_$s.log" 2>/dev/null
+  echo "== $s: $(grep -E '^total' "now_$s.log")" >> defaults.txt
+  "$M" compare "now_$s.exr" "ref_$s.exr" --block 4 >> defaults.txt
+done
+: > seeds.txt
+for s in room95s cornell95s; do
+  for seed in 1 2 3 4 5 6 7 8 9 10; do
+    "$M" render "$s/scene.toml" --seed $seed -o "seed_$s.exr" > /dev/null 2>&1
+    echo "== $s seed $seed: $("$M" compare "seed_$s.exr" "ref_$s.exr" --block 4 | grep -i bias)" >> seeds.txt
   done
 done
 

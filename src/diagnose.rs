@@ -113,105 +113,67 @@ pub fn before_solve(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>>
 /// back shares, and the area lights that see nothing.
 fn lights(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
     let lift = crate::visibility::lift(scene);
-    let diagonal = scene.bounds().diagonal();
     let mut rng = Pcg64Mcg::seed_from_u64(0x5EED_D1A6);
-    // Per light: its power (brightest channel), rays, and for area lights the surface.
     let mut found = Vec::new();
-    let (mut away, mut back, mut total) = (0.0f64, 0.0f64, 0.0f64);
-    let mut backs: Vec<f64> = vec![0.0; scene.surfaces().len()];
-    let mut cast = |rays: Vec<Ray>, power: f64, emitter: Option<u32>| -> Result<()> {
-        let mut hits = vec![None; rays.len()];
-        vis.intersect(&rays, &mut hits)?;
-        let each = power / rays.len().max(1) as f64;
-        let mut met = 0usize;
-        let mut distances: Vec<f32> = hits.iter().flatten().map(|h| h.t).collect();
-        for (ray, hit) in rays.iter().zip(hits) {
-            match landing(scene, ray, hit) {
-                Landing::Away => away += each,
-                Landing::Back(s) => {
-                    back += each;
-                    backs[s as usize] += each;
-                    met += 1;
-                }
-                Landing::Front => met += 1,
-            }
-        }
-        total += power;
-        if let Some(s) = emitter {
-            if (met as f64) < SEES_NOTHING * rays.len() as f64 {
-                found.push(Finding {
-                    fatal: false,
-                    message: format!(
-                        "the area light {} faces away from the scene: its front sees nothing \
-                         ({met} of {} rays from it met a surface). Flip its normals, or set \
-                         two_sided = true on its material.",
-                        surface_name(scene, s),
-                        rays.len()
-                    ),
-                });
-            } else {
-                distances.sort_by(f32::total_cmp);
-                let median = distances[distances.len() / 2];
-                if median < CLOSE * diagonal {
-                    found.push(Finding {
-                        fatal: false,
-                        message: format!(
-                            "the area light {} faces a surface {median:.3} away over most of its                              front: its light is trapped there (a light panel facing the                              ceiling? Blender's lights emit from both sides). Flip its normals,                              or set two_sided = true on its material.",
-                            surface_name(scene, s)
-                        ),
-                    });
-                }
-            }
-        }
-        Ok(())
+    let mut astray = Astray {
+        backs: vec![0.0; scene.surfaces().len()],
+        ..Astray::default()
     };
     for (s, power) in scene.emitters() {
         let rays = crate::light::leaving::rays(scene, s, LIGHT_RAYS, lift, &mut rng);
         if rays.is_empty() {
             continue;
         }
-        cast(rays, power.max_element(), Some(s))?;
-    }
-    for source in scene.point_sources() {
-        let dirs: Vec<Vec3> = (0..LIGHT_RAYS)
-            .map(|_| sphere_direction(&mut rng))
-            .collect();
-        let weights: Vec<f64> = dirs
-            .iter()
-            .map(|&d| f64::from(source.towards(d).max_element()))
-            .collect();
-        let sum: f64 = weights.iter().sum();
-        if sum <= 0.0 {
-            continue;
-        }
-        // Rays weighed by the intensity towards them: cast each direction with its share.
-        let power = sum / LIGHT_RAYS as f64 * 4.0 * std::f64::consts::PI;
-        let rays: Vec<Ray> = dirs
-            .iter()
-            .map(|&dir| Ray {
-                origin: source.position,
-                dir,
-                t_min: 0.0,
-                t_max: f32::INFINITY,
-            })
-            .collect();
         let mut hits = vec![None; rays.len()];
         vis.intersect(&rays, &mut hits)?;
-        for ((ray, hit), w) in rays.iter().zip(hits).zip(&weights) {
-            let each = power * w / sum;
-            match landing(scene, ray, hit) {
-                Landing::Away => away += each,
-                Landing::Back(s) => {
-                    back += each;
-                    backs[s as usize] += each;
-                }
-                Landing::Front => {}
-            }
+        let power = power.max_element();
+        let each = power / rays.len().max(1) as f64;
+        let mut met = 0usize;
+        for (ray, &hit) in rays.iter().zip(&hits) {
+            let landing = landing(scene, ray, hit);
+            met += usize::from(!matches!(landing, Landing::Away));
+            astray.add(landing, each);
         }
-        total += power;
+        astray.total += power;
+        found.extend(trapped(scene, s, &hits, met));
     }
-    if total > 0.0 && (away + back) / total > MOST {
-        let mut worst: Vec<(usize, f64)> = backs
+    for source in scene.point_sources() {
+        point_source(scene, vis, &source, &mut rng, &mut astray)?;
+    }
+    found.extend(astray.finding(scene));
+    Ok(found)
+}
+
+/// The power-weighted shares of the lights' rays that leave the scene and that fall on backs
+/// of one-sided faces (per surface too), of the power `total` cast.
+#[derive(Default)]
+struct Astray {
+    away: f64,
+    back: f64,
+    total: f64,
+    backs: Vec<f64>,
+}
+
+impl Astray {
+    fn add(&mut self, landing: Landing, each: f64) {
+        match landing {
+            Landing::Away => self.away += each,
+            Landing::Back(s) => {
+                self.back += each;
+                self.backs[s as usize] += each;
+            }
+            Landing::Front => {}
+        }
+    }
+
+    /// Where most of the light goes astray: by how much, and the backs that take most.
+    fn finding(&self, scene: &Scene) -> Option<Finding> {
+        let total = self.total;
+        if !(total > 0.0 && (self.away + self.back) / total > MOST) {
+            return None;
+        }
+        let mut worst: Vec<(usize, f64)> = self
+            .backs
             .iter()
             .copied()
             .enumerate()
@@ -232,8 +194,8 @@ fn lights(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
         let mut message = format!(
             "most of the light goes astray: {:.0}% of the emitted power leaves the scene and \
              {:.0}% falls on the backs of one-sided faces, which absorb it unseen.",
-            100.0 * away / total,
-            100.0 * back / total
+            100.0 * self.away / total,
+            100.0 * self.back / total
         );
         if !named.is_empty() {
             message.push_str(&format!(
@@ -244,12 +206,75 @@ fn lights(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Finding>> {
         } else {
             message.push_str(" Is the scene open, or are the lights outside it?");
         }
-        found.push(Finding {
+        Some(Finding {
             fatal: false,
             message,
+        })
+    }
+}
+
+/// An area light (surface `s`) whose front sees nothing (`met` of its rays met a surface), or
+/// faces a surface close by over most of its front: its light is then lost or trapped.
+fn trapped(scene: &Scene, s: u32, hits: &[Option<Hit>], met: usize) -> Option<Finding> {
+    let rays = hits.len();
+    if (met as f64) < SEES_NOTHING * rays as f64 {
+        return Some(Finding {
+            fatal: false,
+            message: format!(
+                "the area light {} faces away from the scene: its front sees nothing ({met} of \
+                 {rays} rays from it met a surface). Flip its normals, or set two_sided = true \
+                 on its material.",
+                surface_name(scene, s),
+            ),
         });
     }
-    Ok(found)
+    let mut distances: Vec<f32> = hits.iter().flatten().map(|h| h.t).collect();
+    distances.sort_by(f32::total_cmp);
+    let median = distances[distances.len() / 2];
+    (median < CLOSE * scene.bounds().diagonal()).then(|| Finding {
+        fatal: false,
+        message: format!(
+            "the area light {} faces a surface {median:.3} away over most of its                              front: its light is trapped there (a light panel facing the                              ceiling? Blender's lights emit from both sides). Flip its normals,                              or set two_sided = true on its material.",
+            surface_name(scene, s)
+        ),
+    })
+}
+
+/// A point light's or luminaire's rays, over the sphere, each weighed by the intensity towards
+/// it, into `astray`.
+fn point_source(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    source: &crate::scene::PointSource,
+    rng: &mut Pcg64Mcg,
+    astray: &mut Astray,
+) -> Result<()> {
+    let dirs: Vec<Vec3> = (0..LIGHT_RAYS).map(|_| sphere_direction(rng)).collect();
+    let weights: Vec<f64> = dirs
+        .iter()
+        .map(|&d| f64::from(source.towards(d).max_element()))
+        .collect();
+    let sum: f64 = weights.iter().sum();
+    if sum <= 0.0 {
+        return Ok(());
+    }
+    let power = sum / LIGHT_RAYS as f64 * 4.0 * std::f64::consts::PI;
+    let rays: Vec<Ray> = dirs
+        .iter()
+        .map(|&dir| Ray {
+            origin: source.position,
+            dir,
+            t_min: 0.0,
+            t_max: f32::INFINITY,
+        })
+        .collect();
+    let mut hits = vec![None; rays.len()];
+    vis.intersect(&rays, &mut hits)?;
+    for ((ray, hit), w) in rays.iter().zip(hits).zip(&weights) {
+        astray.add(landing(scene, ray, hit), power * w / sum);
+    }
+    astray.total += power;
+    Ok(())
 }
 
 /// Whether the camera is outside the scene's bounds, or sees mostly backs or nothing.

@@ -45,6 +45,89 @@ struct Numbers<'a> {
 }
 
 impl<'a> Numbers<'a> {
+    /// The tilt data after `TILT=tilt` (on `tilt_line`): none, or included and skipped (it
+    /// matters only for a lamp tilted away from its test position); a tilt file is refused.
+    fn tilt(&mut self, tilt: &str, tilt_line: usize) -> Result<()> {
+        match tilt {
+            "NONE" => Ok(()),
+            "INCLUDE" => {
+                self.number("the tilt geometry")?;
+                let pairs = self.count("the number of tilt angles", 10_000)?;
+                self.angles("tilt angles", pairs)?;
+                for _ in 0..pairs {
+                    self.number("a tilt factor")?;
+                }
+                Ok(())
+            }
+            other => Err(Error::scene(
+                self.path,
+                Some(tilt_line),
+                format!("TILT={other}: only NONE and INCLUDE are read (a tilt file is not)"),
+            )),
+        }
+    }
+
+    /// Type C angles: vertical within 0–180°, horizontal one of the symmetries the format
+    /// knows.
+    fn check_angles(&self, vertical: &[f64], horizontal: &[f64]) -> Result<()> {
+        let (nv, nh) = (vertical.len(), horizontal.len());
+        let fail = |problem: String| {
+            Err(Error::scene(
+                self.path,
+                Some(self.words[self.next - 1].1),
+                problem,
+            ))
+        };
+        let (v0, v1) = (vertical[0], vertical[nv - 1]);
+        if !(v0 >= 0.0 && v1 <= 180.0) {
+            return fail(format!("vertical angles {v0}–{v1} leave 0–180°"));
+        }
+        let (h0, h1) = (horizontal[0], horizontal[nh - 1]);
+        let symmetric = nh == 1
+            || (h0 == 0.0 && [90.0, 180.0, 360.0].contains(&h1))
+            || (h0 == 90.0 && h1 == 270.0);
+        if !symmetric {
+            return fail(format!(
+                "horizontal angles {h0}–{h1}: type C files run 0, 0–90, 0–180, 90–270 or 0–360"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The `nv` × `nh` candela values, each × `scale`, and nothing after them. Counts that
+    /// promise more values than the file holds are refused before allocating.
+    fn candela(&mut self, nv: usize, nh: usize, scale: f64) -> Result<Vec<f64>> {
+        let fail = |line: usize, problem: String| Err(Error::scene(self.path, Some(line), problem));
+        if nv * nh > self.words.len() - self.next {
+            return fail(
+                self.last_line,
+                format!(
+                    "the file ends before its {} candela values ({nv} × {nh}); it holds {}",
+                    nv * nh,
+                    self.words.len() - self.next
+                ),
+            );
+        }
+        let mut candela = Vec::with_capacity(nv * nh);
+        for _ in 0..nv * nh {
+            let (c, line) = self.number("a candela value")?;
+            if c < 0.0 {
+                return fail(line, format!("candela value {c} is negative"));
+            }
+            candela.push(c * scale);
+        }
+        if let Some(&(extra, line)) = self.words.get(self.next) {
+            return fail(
+                line,
+                format!(
+                    "'{extra}' after the {} candela values its counts announce",
+                    nv * nh
+                ),
+            );
+        }
+        Ok(candela)
+    }
+
     fn new(path: &'a Path, lines: impl Iterator<Item = (usize, &'a str)>) -> Self {
         let mut words = Vec::new();
         let mut last_line = 1;
@@ -139,25 +222,7 @@ impl Photometry {
             .map(|(_, v)| v.trim().to_ascii_uppercase())
             .unwrap_or_default();
         let mut numbers = Numbers::new(path, lines[tilt_at + 1..].iter().copied());
-        match tilt.as_str() {
-            "NONE" => {}
-            "INCLUDE" => {
-                // Lamp-to-luminaire geometry, then pairs of angles and factors: read, not
-                // applied (they matter only for a lamp tilted away from its test position).
-                numbers.number("the tilt geometry")?;
-                let pairs = numbers.count("the number of tilt angles", 10_000)?;
-                numbers.angles("tilt angles", pairs)?;
-                for _ in 0..pairs {
-                    numbers.number("a tilt factor")?;
-                }
-            }
-            other => {
-                return fail(
-                    tilt_line,
-                    format!("TILT={other}: only NONE and INCLUDE are read (a tilt file is not)"),
-                )
-            }
-        }
+        numbers.tilt(&tilt, tilt_line)?;
         numbers.number("the number of lamps")?;
         let (lumens, _) = numbers.number("lumens per lamp")?;
         let (multiplier, multiplier_line) = numbers.number("the candela multiplier")?;
@@ -195,54 +260,9 @@ impl Photometry {
         let (input_watts, _) = numbers.number("the input watts")?;
         let vertical = numbers.angles("vertical angles", nv)?;
         let horizontal = numbers.angles("horizontal angles", nh)?;
-        let (v0, v1) = (vertical[0], vertical[nv - 1]);
-        if !(v0 >= 0.0 && v1 <= 180.0) {
-            return fail(
-                numbers.words[numbers.next - 1].1,
-                format!("vertical angles {v0}–{v1} leave 0–180°"),
-            );
-        }
-        let (h0, h1) = (horizontal[0], horizontal[nh - 1]);
-        let symmetric = nh == 1
-            || (h0 == 0.0 && [90.0, 180.0, 360.0].contains(&h1))
-            || (h0 == 90.0 && h1 == 270.0);
-        if !symmetric {
-            return fail(
-                numbers.words[numbers.next - 1].1,
-                format!(
-                    "horizontal angles {h0}–{h1}: type C files run 0, 0–90, 0–180, 90–270 or 0–360"
-                ),
-            );
-        }
+        numbers.check_angles(&vertical, &horizontal)?;
         let scale = multiplier * ballast * ballast_lamp;
-        // Counts that promise more values than the file holds are refused before allocating.
-        if nv * nh > numbers.words.len() - numbers.next {
-            return fail(
-                numbers.last_line,
-                format!(
-                    "the file ends before its {} candela values ({nv} × {nh}); it holds {}",
-                    nv * nh,
-                    numbers.words.len() - numbers.next
-                ),
-            );
-        }
-        let mut candela = Vec::with_capacity(nv * nh);
-        for _ in 0..nv * nh {
-            let (c, line) = numbers.number("a candela value")?;
-            if c < 0.0 {
-                return fail(line, format!("candela value {c} is negative"));
-            }
-            candela.push(c * scale);
-        }
-        if let Some(&(extra, line)) = numbers.words.get(numbers.next) {
-            return fail(
-                line,
-                format!(
-                    "'{extra}' after the {} candela values its counts announce",
-                    nv * nh
-                ),
-            );
-        }
+        let candela = numbers.candela(nv, nh, scale)?;
         Ok(Photometry {
             vertical,
             horizontal,

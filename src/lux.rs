@@ -51,6 +51,34 @@ impl Default for LuxOptions {
     }
 }
 
+impl LuxOptions {
+    /// Checks the grids' settings: the first out of its range, as an
+    /// [`Error::Argument`](crate::Error::Argument) naming it.
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=crate::solver::MAX_SPECULAR_RAYS).contains(&self.specular_rays) {
+            return Err(crate::Error::argument(
+                "specular_rays",
+                format!(
+                    "{} chains per point: must lie in 1..={}",
+                    self.specular_rays,
+                    crate::solver::MAX_SPECULAR_RAYS
+                ),
+            ));
+        }
+        if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&self.light_samples) {
+            return Err(crate::Error::argument(
+                "light_samples",
+                format!(
+                    "{} shadow rays per area light: must lie in 1..={}",
+                    self.light_samples,
+                    crate::light::MAX_LIGHT_SAMPLES
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// What a grid measured.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
@@ -79,26 +107,7 @@ pub fn illuminance(
         let checked = crate::visibility::Checked::new(vis, scene);
         let vis: &dyn crate::visibility::Visibility = &checked;
         solution.check_fits(scene)?;
-        if !(1..=crate::solver::MAX_SPECULAR_RAYS).contains(&options.specular_rays) {
-            return Err(crate::Error::argument(
-                "specular_rays",
-                format!(
-                    "{} chains per point: must lie in 1..={}",
-                    options.specular_rays,
-                    crate::solver::MAX_SPECULAR_RAYS
-                ),
-            ));
-        }
-        if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&options.light_samples) {
-            return Err(crate::Error::argument(
-                "light_samples",
-                format!(
-                    "{} shadow rays per area light: must lie in 1..={}",
-                    options.light_samples,
-                    crate::light::MAX_LIGHT_SAMPLES
-                ),
-            ));
-        }
+        options.validate()?;
         let points = grid.points();
         let n = grid.normal;
         let mut reporter = Reporter::new(progress);
@@ -119,24 +128,11 @@ pub fn illuminance(
         };
         // Daylight entering, with more rays than a sample's: a grid has few points.
         if let Some(entering) = crate::daylight::entering::Entering::of(scene, GRID_SKY_RAYS) {
-            let mut daylight = vec![DVec3::ZERO; points.len()];
-            if !reporter.stopped() {
-                let work = |first: usize, chunk: &mut [DVec3]| {
-                    let range = first..first + chunk.len();
-                    let (got, _) =
-                        entering.at(vis, &at[range.clone()], &ids[range], options.seed)?;
-                    chunk.copy_from_slice(&got);
-                    Ok(())
-                };
-                let part = &mut reporter.part(base);
-                crate::parallel::for_chunks_reporting(
-                    &mut daylight,
-                    8,
-                    options.threads,
-                    work,
-                    part,
-                )?;
-            }
+            let daylight = if reporter.stopped() {
+                vec![DVec3::ZERO; points.len()]
+            } else {
+                entering_at(&entering, vis, &at, &ids, options, &mut reporter.part(base))?
+            };
             for (d, e) in direct.iter_mut().zip(daylight) {
                 d.irradiance += e;
             }
@@ -198,6 +194,26 @@ pub fn illuminance(
             .collect();
         Ok(Illuminance { values, measured })
     })
+}
+
+/// The daylight entering at grid points `at` (with their ids).
+fn entering_at(
+    entering: &crate::daylight::entering::Entering,
+    vis: &dyn Visibility,
+    at: &[(Vec3, Vec3)],
+    ids: &[u32],
+    options: &LuxOptions,
+    report: crate::parallel::Report,
+) -> Result<Vec<DVec3>> {
+    let mut daylight = vec![DVec3::ZERO; at.len()];
+    let work = |first: usize, chunk: &mut [DVec3]| {
+        let range = first..first + chunk.len();
+        let (got, _) = entering.at(vis, &at[range.clone()], &ids[range], options.seed)?;
+        chunk.copy_from_slice(&got);
+        Ok(())
+    };
+    crate::parallel::for_chunks_reporting(&mut daylight, 8, options.threads, work, report)?;
+    Ok(daylight)
 }
 
 /// The samples that face grid point `x` (facing `n`) and that `wanted` keeps: each one's

@@ -179,44 +179,8 @@ pub fn run(
 
     #[cfg(feature = "embree")]
     if options.backends.contains(&Backend::Embree) {
-        use meshlight::visibility::{embree_headers, EmbreeMode, EmbreeOptions, EmbreeScene};
-        report.embree_headers = Some(embree_headers());
-        let embree = EmbreeScene::new(scene, EmbreeOptions::default())?;
-        let mut occluded = vec![false; segments.len()];
-        let mut hits = vec![None; rays.len()];
-        for mode in EmbreeMode::all() {
-            let mut raw = RawReport {
-                mode: mode.name(),
-                occlusion: Vec::new(),
-                intersect: Vec::new(),
-            };
-            for &threads in &options.threads {
-                progress(&format!(
-                    "embree raw shim {}: {threads} thread(s)",
-                    mode.name()
-                ));
-                // The whole per-thread share in one call: the shim's best case.
-                let (time, ()) = best_of(repeats, || {
-                    parallel(&segments, &mut occluded, threads, usize::MAX, |s, o| {
-                        embree.occluded_with(mode, s, o)
-                    })
-                })?;
-                raw.occlusion.push(Rate {
-                    threads,
-                    per_second: segments.len() as f64 / time.as_secs_f64(),
-                });
-                let (time, ()) = best_of(repeats, || {
-                    parallel(&rays, &mut hits, threads, usize::MAX, |r, o| {
-                        embree.intersect_with(mode, r, o)
-                    })
-                })?;
-                raw.intersect.push(Rate {
-                    threads,
-                    per_second: rays.len() as f64 / time.as_secs_f64(),
-                });
-            }
-            report.embree_raw.push(raw);
-        }
+        report.embree_headers = Some(meshlight::visibility::embree_headers());
+        report.embree_raw = embree_raw(scene, options, &segments, &rays, progress)?;
     }
 
     let embree = answers.iter().find(|a| a.0 == Backend::Embree);
@@ -225,6 +189,58 @@ pub fn run(
         report.agreement = Some(compare(&e.1, &b.1, &e.2, &b.2));
     }
     Ok(report)
+}
+
+/// The Embree shim's rates in each of its modes, the whole per-thread share in one call: the
+/// shim's best case, against which the trait's overhead shows.
+#[cfg(feature = "embree")]
+fn embree_raw(
+    scene: &Scene,
+    options: &BenchOptions,
+    segments: &[meshlight::visibility::Segment],
+    rays: &[meshlight::visibility::Ray],
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<RawReport>> {
+    use meshlight::visibility::{EmbreeMode, EmbreeOptions, EmbreeScene};
+    let repeats = options.repeats.max(1);
+    let mut reports = Vec::new();
+    let embree = EmbreeScene::new(scene, EmbreeOptions::default())?;
+    let mut occluded = vec![false; segments.len()];
+    let mut hits = vec![None; rays.len()];
+    for mode in EmbreeMode::all() {
+        let mut raw = RawReport {
+            mode: mode.name(),
+            occlusion: Vec::new(),
+            intersect: Vec::new(),
+        };
+        for &threads in &options.threads {
+            progress(&format!(
+                "embree raw shim {}: {threads} thread(s)",
+                mode.name()
+            ));
+            // The whole per-thread share in one call: the shim's best case.
+            let (time, ()) = best_of(repeats, || {
+                parallel(segments, &mut occluded, threads, usize::MAX, |s, o| {
+                    embree.occluded_with(mode, s, o)
+                })
+            })?;
+            raw.occlusion.push(Rate {
+                threads,
+                per_second: segments.len() as f64 / time.as_secs_f64(),
+            });
+            let (time, ()) = best_of(repeats, || {
+                parallel(rays, &mut hits, threads, usize::MAX, |r, o| {
+                    embree.intersect_with(mode, r, o)
+                })
+            })?;
+            raw.intersect.push(Rate {
+                threads,
+                per_second: rays.len() as f64 / time.as_secs_f64(),
+            });
+        }
+        reports.push(raw);
+    }
+    Ok(reports)
 }
 
 /// Counts where two backends' answers differ.

@@ -131,15 +131,7 @@ pub fn measure(
         let left_out = values.len() - open.len();
         let stem = grid.file_stem();
         let csv = dir.join(format!("{stem}.csv"));
-        let mut out = std::io::BufWriter::new(
-            std::fs::File::create(&csv)
-                .with_context(|| format!("{}: cannot write", csv.display()))?,
-        );
-        writeln!(out, "x,y,z,E,in_solid")?;
-        for ((p, v), &solid) in points.iter().zip(&values).zip(&inside) {
-            writeln!(out, "{},{},{},{v},{}", p.x, p.y, p.z, u8::from(solid))?;
-        }
-        out.flush()?;
+        write_csv(&csv, &points, &values, &inside)?;
         let s = Summary::of(&open);
         let line = format!(
             "grid '{}': {} points{}, Emin {} {unit}, Eavg {} {unit}, Emax {} {unit}, U0 = Emin/Eavg {:.2}, Emin/Emax {:.2}; {:.2} s",
@@ -158,31 +150,7 @@ pub fn measure(
             started.elapsed().as_secs_f64()
         );
         let png = dir.join(format!("{stem}.png"));
-        let (nu, nv) = grid.counts_uv();
-        let (u, v) = grid.edges();
-        let caption = [
-            format!("Emin {} {unit}", round_label(s.min)),
-            format!("Eavg {} {unit}", round_label(s.avg)),
-            format!("Emax {} {unit}", round_label(s.max)),
-            format!("U0 {:.2}", s.uniformity()),
-        ];
-        super::plan::plan_png(
-            &png,
-            &Plan {
-                counts: (nu, nv),
-                values: &values,
-                excluded: &inside,
-                spacing: (
-                    f64::from(u.length()) / f64::from(nu),
-                    f64::from(v.length()) / f64::from(nv),
-                ),
-                marks: &lights_over(scene, grid),
-                outline: &cut(scene, grid),
-                unit,
-                title: &format!("{} ({unit})", grid.name()),
-                caption: &caption,
-            },
-        )?;
+        isolux_plan(&png, scene, grid, &values, &inside, &s)?;
         println!("{line}");
         let verdict = targets(grid.target_em(), grid.target_u0(), &s, unit);
         if let Some(verdict) = &verdict {
@@ -195,32 +163,8 @@ pub fn measure(
         // The same plan in daylight factor, where it is defined.
         let df_png = match df_sky(scene) {
             Some(eh) => {
-                let df: Vec<f64> = values.iter().map(|v| 100.0 * v / eh).collect();
                 let path = dir.join(format!("{stem}-df.png"));
-                // "daylight factor min a%, average b%, median c% (E_h …)": a line each.
-                let caption: Vec<String> = daylight
-                    .iter()
-                    .filter_map(|l| l.strip_prefix("daylight factor "))
-                    .flat_map(|l| l.split(" (").next().unwrap_or("").split(", "))
-                    .map(|part| format!("DF {part}"))
-                    .collect();
-                super::plan::plan_png(
-                    &path,
-                    &Plan {
-                        counts: (nu, nv),
-                        values: &df,
-                        excluded: &inside,
-                        spacing: (
-                            f64::from(u.length()) / f64::from(nu),
-                            f64::from(v.length()) / f64::from(nv),
-                        ),
-                        marks: &[],
-                        outline: &cut(scene, grid),
-                        unit: "%",
-                        title: &format!("{} (daylight factor, %)", grid.name()),
-                        caption: &caption,
-                    },
-                )?;
+                df_plan(&path, scene, grid, &values, &inside, eh, &daylight)?;
                 Some(path)
             }
             None => None,
@@ -241,6 +185,96 @@ pub fn measure(
         });
     }
     Ok(measured)
+}
+
+/// A grid's values as CSV: x,y,z,E,in_solid.
+fn write_csv(csv: &Path, points: &[glam::Vec3], values: &[f64], inside: &[bool]) -> Result<()> {
+    let mut out = std::io::BufWriter::new(
+        std::fs::File::create(csv).with_context(|| format!("{}: cannot write", csv.display()))?,
+    );
+    writeln!(out, "x,y,z,E,in_solid")?;
+    for ((p, v), &solid) in points.iter().zip(values).zip(inside) {
+        writeln!(out, "{},{},{},{v},{}", p.x, p.y, p.z, u8::from(solid))?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// A grid's isolux plan, its figures in the caption, the lights over it marked.
+fn isolux_plan(
+    png: &Path,
+    scene: &Scene,
+    grid: &meshlight::scene::Grid,
+    values: &[f64],
+    inside: &[bool],
+    s: &Summary,
+) -> Result<()> {
+    let unit = scene.units().irradiance();
+    let (nu, nv) = grid.counts_uv();
+    let (u, v) = grid.edges();
+    let caption = [
+        format!("Emin {} {unit}", round_label(s.min)),
+        format!("Eavg {} {unit}", round_label(s.avg)),
+        format!("Emax {} {unit}", round_label(s.max)),
+        format!("U0 {:.2}", s.uniformity()),
+    ];
+    super::plan::plan_png(
+        png,
+        &Plan {
+            counts: (nu, nv),
+            values,
+            excluded: inside,
+            spacing: (
+                f64::from(u.length()) / f64::from(nu),
+                f64::from(v.length()) / f64::from(nv),
+            ),
+            marks: &lights_over(scene, grid),
+            outline: &cut(scene, grid),
+            unit,
+            title: &format!("{} ({unit})", grid.name()),
+            caption: &caption,
+        },
+    )
+}
+
+/// The same plan in daylight factor (%, against the sky's `eh`), its figures from the
+/// `daylight` lines in the caption.
+fn df_plan(
+    path: &Path,
+    scene: &Scene,
+    grid: &meshlight::scene::Grid,
+    values: &[f64],
+    inside: &[bool],
+    eh: f64,
+    daylight: &[String],
+) -> Result<()> {
+    let (nu, nv) = grid.counts_uv();
+    let (u, v) = grid.edges();
+    let df: Vec<f64> = values.iter().map(|v| 100.0 * v / eh).collect();
+    // "daylight factor min a%, average b%, median c% (E_h …)": a line each.
+    let caption: Vec<String> = daylight
+        .iter()
+        .filter_map(|l| l.strip_prefix("daylight factor "))
+        .flat_map(|l| l.split(" (").next().unwrap_or("").split(", "))
+        .map(|part| format!("DF {part}"))
+        .collect();
+    super::plan::plan_png(
+        path,
+        &Plan {
+            counts: (nu, nv),
+            values: &df,
+            excluded: inside,
+            spacing: (
+                f64::from(u.length()) / f64::from(nu),
+                f64::from(v.length()) / f64::from(nv),
+            ),
+            marks: &[],
+            outline: &cut(scene, grid),
+            unit: "%",
+            title: &format!("{} (daylight factor, %)", grid.name()),
+            caption: &caption,
+        },
+    )
 }
 
 /// E_h of the scene's sky where the daylight factor is defined (an overcast or uniform sky).

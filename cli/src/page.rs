@@ -51,10 +51,30 @@ pub fn write(
 }
 
 fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras) -> Result<String> {
-    let units = scene.units();
-    let (lux, flux) = (units.irradiance(), units.flux());
-    let name = escape(&scene.path().display().to_string());
     let mut h = String::new();
+    header(&mut h, scene)?;
+    lights_section(&mut h, scene)?;
+    grids_section(&mut h, scene, grids)?;
+    if grids.iter().any(|g| !g.daylight.is_empty()) {
+        daylight_section(&mut h, grids)?;
+    }
+    if let Some(annual) = &extras.annual {
+        annual_section(&mut h, annual)?;
+    }
+    plans_section(&mut h, grids)?;
+    if !extras.views.is_empty() {
+        views_section(&mut h, extras)?;
+    }
+    method_section(&mut h, solution, extras)?;
+    writeln!(h, "</body>\n</html>")?;
+    Ok(h)
+}
+
+/// The document's head and the page's title block.
+fn header(h: &mut String, scene: &Scene) -> Result<()> {
+    let units = scene.units();
+    let flux = units.flux();
+    let name = escape(&scene.path().display().to_string());
     writeln!(
         h,
         "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
@@ -75,7 +95,12 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
         env!("CARGO_PKG_VERSION"),
     )?;
 
-    // Lights: luminaires, point lights, area lights, with their flux.
+    Ok(())
+}
+
+/// Lights: luminaires (one row per file and tint), point lights, area lights, with their flux.
+fn lights_section(h: &mut String, scene: &Scene) -> Result<()> {
+    let flux = scene.units().flux();
     writeln!(h, "<section id=\"luminaires\"><h2>Luminaire schedule</h2>")?;
     writeln!(
         h,
@@ -137,7 +162,12 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
     }
     writeln!(h, "</tbody></table></section>")?;
 
-    // Grids.
+    Ok(())
+}
+
+/// Every grid's figures against its targets.
+fn grids_section(h: &mut String, scene: &Scene, grids: &[Measured]) -> Result<()> {
+    let lux = scene.units().irradiance();
     writeln!(h, "<section id=\"grids\"><h2>Calculation grids</h2>")?;
     writeln!(
         h,
@@ -187,47 +217,48 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
             .join(", ")
     )?;
 
-    // Daylight factor, where the sky is overcast or uniform.
-    if grids.iter().any(|g| !g.daylight.is_empty()) {
-        writeln!(h, "<section id=\"daylight\"><h2>Daylight factor</h2><ul>")?;
-        for g in grids {
-            for said in &g.daylight {
-                let class = if said.contains("NOT met") || said.starts_with("no daylight") {
-                    " class=\"fail\""
-                } else if said.contains(": met") {
-                    " class=\"pass\""
-                } else {
-                    ""
-                };
-                writeln!(h, "<li{class}>{}: {}</li>", escape(&g.name), escape(said))?;
-            }
+    Ok(())
+}
+
+/// The daylight factor, where the sky is overcast or uniform: each grid's verdicts and plan.
+fn daylight_section(h: &mut String, grids: &[Measured]) -> Result<()> {
+    writeln!(h, "<section id=\"daylight\"><h2>Daylight factor</h2><ul>")?;
+    for g in grids {
+        for said in &g.daylight {
+            let class = if said.contains("NOT met") || said.starts_with("no daylight") {
+                " class=\"fail\""
+            } else if said.contains(": met") {
+                " class=\"pass\""
+            } else {
+                ""
+            };
+            writeln!(h, "<li{class}>{}: {}</li>", escape(&g.name), escape(said))?;
         }
+    }
+    writeln!(
+        h,
+        "</ul><p>DF = E / E<sub>h</sub>, E<sub>h</sub> the sky's illuminance on an \
+             unobstructed horizontal plane.</p>"
+    )?;
+    for g in grids {
+        let Some(path) = &g.df_png else { continue };
+        let png =
+            std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
         writeln!(
             h,
-            "</ul><p>DF = E / E<sub>h</sub>, E<sub>h</sub> the sky's illuminance on an \
-             unobstructed horizontal plane.</p>"
-        )?;
-        for g in grids {
-            let Some(path) = &g.df_png else { continue };
-            let png =
-                std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
-            writeln!(
-                h,
-                "<figure><img alt=\"daylight factor plan of {n}\" \
+            "<figure><img alt=\"daylight factor plan of {n}\" \
                  src=\"data:image/png;base64,{}\"><figcaption>{n}: daylight factor, \
                  iso-lines at round values (%)</figcaption></figure>",
-                base64(&png),
-                n = escape(&g.name)
-            )?;
-        }
-        writeln!(h, "</section>")?;
+            base64(&png),
+            n = escape(&g.name)
+        )?;
     }
+    writeln!(h, "</section>")?;
+    Ok(())
+}
 
-    if let Some(annual) = &extras.annual {
-        annual_section(&mut h, annual)?;
-    }
-
-    // Plans.
+/// Each grid's isolux plan.
+fn plans_section(h: &mut String, grids: &[Measured]) -> Result<()> {
     writeln!(h, "<section id=\"plans\"><h2>Isolux plans</h2>")?;
     for g in grids {
         let png =
@@ -242,23 +273,31 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
     }
     writeln!(h, "</section>")?;
 
-    if !extras.views.is_empty() {
-        writeln!(h, "<section id=\"views\"><h2>Rendered view</h2>")?;
-        let captions = [
-            "The camera's view, radiance tone-mapped to sRGB.",
-            "The same view's luminance in false colour.",
-        ];
-        for (view, caption) in extras.views.iter().zip(captions) {
-            writeln!(
-                h,
-                "<figure><img alt=\"{caption}\" src=\"data:image/png;base64,{}\">\
-                 <figcaption>{caption}</figcaption></figure>",
-                base64(view)
-            )?;
-        }
-        writeln!(h, "</section>")?;
-    }
+    Ok(())
+}
 
+/// The rendered view: tone-mapped, then its luminance in false colour.
+fn views_section(h: &mut String, extras: &Extras) -> Result<()> {
+    writeln!(h, "<section id=\"views\"><h2>Rendered view</h2>")?;
+    let captions = [
+        "The camera's view, radiance tone-mapped to sRGB.",
+        "The same view's luminance in false colour.",
+    ];
+    for (view, caption) in extras.views.iter().zip(captions) {
+        writeln!(
+            h,
+            "<figure><img alt=\"{caption}\" src=\"data:image/png;base64,{}\">\
+                 <figcaption>{caption}</figcaption></figure>",
+            base64(view)
+        )?;
+    }
+    writeln!(h, "</section>")?;
+    Ok(())
+}
+
+/// How it was computed: the samples, the times, the solve's summary, and where the accuracy is
+/// measured.
+fn method_section(h: &mut String, solution: &Solution, extras: &Extras) -> Result<()> {
     let (solve, measure, view) = extras.seconds;
     writeln!(
         h,
@@ -275,8 +314,7 @@ fn page(scene: &Scene, solution: &Solution, grids: &[Measured], extras: &Extras)
         round_label(view),
         escape(extras.summary.trim_end())
     )?;
-    writeln!(h, "</body>\n</html>")?;
-    Ok(h)
+    Ok(())
 }
 
 /// The year: the weather, each grid's climate-based metrics and verdicts, and its plans.

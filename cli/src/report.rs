@@ -10,6 +10,9 @@ use meshlight::{Image, Scene, Solution};
 
 use super::bench::{BenchReport, Rate};
 
+/// How many of each kind of light `info` lists.
+const LISTED: usize = 10;
+
 fn v3(v: Vec3) -> String {
     format!("[{}, {}, {}]", v.x, v.y, v.z)
 }
@@ -48,8 +51,23 @@ fn material_line(m: &meshlight::scene::Material) -> String {
 /// `meshlight info`.
 pub fn info(scene: &Scene) -> String {
     let mut s = String::new();
+    info_geometry(&mut s, scene);
+    info_lights(&mut s, scene);
+    info_camera_and_sky(&mut s, scene);
+    match scene.solver_defaults().epsilon {
+        Some(e) => {
+            let _ = writeln!(s, "solver        epsilon {e} (scene file)");
+        }
+        None => {
+            let _ = writeln!(s, "solver        no defaults in the scene file");
+        }
+    }
+    s
+}
+
+/// `info`'s geometry: triangles, surfaces, materials, area, bounds.
+fn info_geometry(s: &mut String, scene: &Scene) {
     let b = &scene.bounds();
-    let c = &scene.camera();
     let _ = writeln!(s, "scene         {}", scene.path().display());
     let _ = writeln!(s, "triangles     {}", scene.triangles().len());
     let _ = writeln!(s, "surfaces      {}", scene.surfaces().len());
@@ -70,6 +88,11 @@ pub fn info(scene: &Scene) -> String {
         v3(b.max),
         b.diagonal()
     );
+}
+
+/// `info`'s lights: area lights (the first few listed), point lights, luminaires, and the power
+/// they emit.
+fn info_lights(s: &mut String, scene: &Scene) {
     let emitters: Vec<_> = scene.emitters().collect();
     let area: f64 = 0.0
         + emitters
@@ -90,7 +113,6 @@ pub fn info(scene: &Scene) -> String {
         area,
         rgb(power)
     );
-    const LISTED: usize = 10;
     for &(i, p) in emitters.iter().take(LISTED) {
         let surface = &scene.surfaces()[i as usize];
         let _ = writeln!(
@@ -144,6 +166,11 @@ pub fn info(scene: &Scene) -> String {
         rgb(scene.emitted_power()),
         u.flux()
     );
+}
+
+/// `info`'s camera, specular surfaces, sky and year.
+fn info_camera_and_sky(s: &mut String, scene: &Scene) {
+    let c = &scene.camera();
     let _ = writeln!(
         s,
         "camera        at {} looking at {}, up {}, fov_y {}°, {}x{}",
@@ -206,15 +233,6 @@ pub fn info(scene: &Scene) -> String {
             meshlight::daylight::patches::Patches::new(a.sky_subdivision).len()
         );
     }
-    match scene.solver_defaults().epsilon {
-        Some(e) => {
-            let _ = writeln!(s, "solver        epsilon {e} (scene file)");
-        }
-        None => {
-            let _ = writeln!(s, "solver        no defaults in the scene file");
-        }
-    }
-    s
 }
 
 fn mega(rates: &[Rate], threads: usize) -> Option<f64> {
@@ -251,13 +269,7 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
     if let Some(h) = r.embree_headers {
         let _ = writeln!(s, "embree shim compiled against {h}");
     }
-    let heads = |what: &str| {
-        threads
-            .iter()
-            .map(|t| format!("{:>9}", format!("{what} {t}T")))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
+    let heads = |what: &str| heads(threads.as_ref(), what);
     let _ = writeln!(
         s,
         "\nMillion queries per second (best of runs), through the Visibility trait:"
@@ -281,71 +293,9 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
         );
     }
     if !r.embree_raw.is_empty() {
-        let _ = writeln!(s, "\nEmbree raw shim, whole share per call (Mq/s):");
-        let _ = writeln!(
-            s,
-            "{:<28} {:>10} {} {}",
-            "mode",
-            "",
-            heads("occl"),
-            heads("hit")
-        );
-        for raw in &r.embree_raw {
-            let _ = writeln!(
-                s,
-                "{:<28} {:>10} {} {}",
-                raw.mode,
-                "",
-                cells(&raw.occlusion, &threads),
-                cells(&raw.intersect, &threads)
-            );
-        }
-        if let Some(embree) = r
-            .backends
-            .iter()
-            .find(|b| b.backend == meshlight::Backend::Embree)
-        {
-            for &t in &threads {
-                let best = r
-                    .embree_raw
-                    .iter()
-                    .filter_map(|raw| mega(&raw.occlusion, t))
-                    .fold(0.0, f64::max);
-                if let (Some(through), true) = (mega(&embree.occlusion, t), best > 0.0) {
-                    let _ = writeln!(
-                        s,
-                        "trait / best raw path, {t} thread(s): {:.1}%",
-                        100.0 * through / best
-                    );
-                }
-            }
-        }
+        bench_raw(&mut s, r, &threads);
     }
-    let embree = r
-        .backends
-        .iter()
-        .find(|b| b.backend == meshlight::Backend::Embree);
-    if let Some(e) = embree {
-        for b in r
-            .backends
-            .iter()
-            .filter(|b| b.backend != meshlight::Backend::Embree)
-        {
-            for &t in &threads {
-                if let (Some(x), Some(y)) = (mega(&e.occlusion, t), mega(&b.occlusion, t)) {
-                    let hx = mega(&e.intersect, t).unwrap_or(0.0);
-                    let hy = mega(&b.intersect, t).unwrap_or(f64::NAN);
-                    let _ = writeln!(
-                        s,
-                        "embree / {}, {t} thread(s): occlusion {:.2}x, closest hit {:.2}x",
-                        b.detail,
-                        x / y,
-                        hx / hy
-                    );
-                }
-            }
-        }
-    }
+    bench_ratios(&mut s, r, &threads);
     if let Some(a) = r.agreement {
         let _ = writeln!(
             s,
@@ -361,9 +311,113 @@ pub fn bench_report(scene: &Scene, r: &BenchReport) -> String {
     s
 }
 
+/// A column heading per thread count: "occl 2T".
+fn heads(threads: &[usize], what: &str) -> String {
+    threads
+        .iter()
+        .map(|t| format!("{:>9}", format!("{what} {t}T")))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The Embree shim's raw rates, and the trait's share of the best raw path.
+fn bench_raw(s: &mut String, r: &BenchReport, threads: &[usize]) {
+    let heads = |what: &str| heads(threads, what);
+    let _ = writeln!(s, "\nEmbree raw shim, whole share per call (Mq/s):");
+    let _ = writeln!(
+        s,
+        "{:<28} {:>10} {} {}",
+        "mode",
+        "",
+        heads("occl"),
+        heads("hit")
+    );
+    for raw in &r.embree_raw {
+        let _ = writeln!(
+            s,
+            "{:<28} {:>10} {} {}",
+            raw.mode,
+            "",
+            cells(&raw.occlusion, threads),
+            cells(&raw.intersect, threads)
+        );
+    }
+    if let Some(embree) = r
+        .backends
+        .iter()
+        .find(|b| b.backend == meshlight::Backend::Embree)
+    {
+        for &t in threads {
+            let best = r
+                .embree_raw
+                .iter()
+                .filter_map(|raw| mega(&raw.occlusion, t))
+                .fold(0.0, f64::max);
+            if let (Some(through), true) = (mega(&embree.occlusion, t), best > 0.0) {
+                let _ = writeln!(
+                    s,
+                    "trait / best raw path, {t} thread(s): {:.1}%",
+                    100.0 * through / best
+                );
+            }
+        }
+    }
+}
+
+/// Embree's rates over each other backend's, thread count by thread count.
+fn bench_ratios(s: &mut String, r: &BenchReport, threads: &[usize]) {
+    let embree = r
+        .backends
+        .iter()
+        .find(|b| b.backend == meshlight::Backend::Embree);
+    if let Some(e) = embree {
+        for b in r
+            .backends
+            .iter()
+            .filter(|b| b.backend != meshlight::Backend::Embree)
+        {
+            for &t in threads {
+                if let (Some(x), Some(y)) = (mega(&e.occlusion, t), mega(&b.occlusion, t)) {
+                    let hx = mega(&e.intersect, t).unwrap_or(0.0);
+                    let hy = mega(&b.intersect, t).unwrap_or(f64::NAN);
+                    let _ = writeln!(
+                        s,
+                        "embree / {}, {t} thread(s): occlusion {:.2}x, closest hit {:.2}x",
+                        b.detail,
+                        x / y,
+                        hx / hy
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// The solve's summary: samples per round, shots, queries, unshot fraction, time per phase.
 pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) -> String {
     let mut out = String::new();
+    summary_settings(&mut out, scene, s, o, backend);
+    summary_rounds(&mut out, s);
+    if s.stop() == StopReason::Diverged {
+        let _ = writeln!(
+            out,
+            "warning: the solve diverged: its unshot power grew; the image is not to be trusted"
+        );
+    }
+    summary_memory(&mut out, s, o);
+    summary_energy(&mut out, scene, s);
+    if s.stop() == StopReason::ShotLimit {
+        let _ = writeln!(
+            out,
+            "warning: the last solve stopped at its shot limit with {:.2e} of the emitted power unshot",
+            s.rounds().last().map_or(0.0, |r| r.shooting.unshot_fraction)
+        );
+    }
+    out
+}
+
+/// The summary's first line: the scene, the backend and the settings that matter most.
+fn summary_settings(out: &mut String, scene: &Scene, s: &Solution, o: &Options, backend: &str) {
     let source = match s.epsilon_source() {
         EpsilonSource::Options => "command line",
         EpsilonSource::SceneFile => "scene file",
@@ -392,6 +446,10 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
         o.zeta,
         o.light_samples
     );
+}
+
+/// The summary's table: a row per round.
+fn summary_rounds(out: &mut String, s: &Solution) {
     let _ = writeln!(
         out,
         "{:>5} {:>8} {:>7} {:>7} {:>8} {:>10} {:>11} {:>9} {:>17} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8}",
@@ -441,12 +499,10 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
             if r.capped { "  (sample budget reached)" } else { "" }
         );
     }
-    if s.stop() == StopReason::Diverged {
-        let _ = writeln!(
-            out,
-            "warning: the solve diverged: its unshot power grew; the image is not to be trusted"
-        );
-    }
+}
+
+/// What the samples and the links held against the budget, and over ranks what each held.
+fn summary_memory(out: &mut String, s: &Solution, o: &Options) {
     let bytes: u64 = s
         .rounds()
         .iter()
@@ -491,6 +547,11 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
             );
         }
     }
+}
+
+/// Where the emitted light went, where the account adds up (a single solve, no specular
+/// surfaces).
+fn summary_energy(out: &mut String, scene: &Scene, s: &Solution) {
     let emitted = s.ledger().emitted.element_sum();
     // Adaptive rounds start new samples from interpolated light, which the ledger does not
     // follow: only a single solve's account adds up. Specular surfaces have no samples: what
@@ -509,14 +570,6 @@ pub fn solve_summary(scene: &Scene, s: &Solution, o: &Options, backend: &str) ->
             share(s.unshot_power().element_sum())
         );
     }
-    if s.stop() == StopReason::ShotLimit {
-        let _ = writeln!(
-            out,
-            "warning: the last solve stopped at its shot limit with {:.2e} of the emitted power unshot",
-            s.rounds().last().map_or(0.0, |r| r.shooting.unshot_fraction)
-        );
-    }
-    out
 }
 
 /// The render's summary.

@@ -166,6 +166,9 @@ fn apply(key: &str, v: &str, o: &mut Options, extra: &mut Extra) -> Result<()> {
     Ok(())
 }
 
+/// One combination of the varied settings: (key, value) in the order given.
+type Point = Vec<(String, String)>;
+
 /// Every combination of the varied values, the first key varying slowest.
 fn grid(vary: &[(String, Vec<String>)]) -> Vec<Vec<(String, String)>> {
     let mut points: Vec<Vec<(String, String)>> = vec![Vec::new()];
@@ -211,47 +214,9 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
     if let Err(e) = scene.set_camera(camera) {
         bail!("the reference's size does not make a camera: {e}");
     }
-    // Check every setting before the first run.
-    if sweep.block != 1 {
-        meshlight::metrics::block_average(reference, sweep.block)?;
-    }
-    for (key, _) in &sweep.vary {
-        if !used_by(sweep.method, key) {
-            bail!(
-                "--vary {key}: the {} method does not use it",
-                method_name(sweep.method)
-            );
-        }
-    }
+    check(reference, sweep)?;
     let points = grid(&sweep.vary);
-    let mut runs = Vec::with_capacity(points.len());
-    for point in &points {
-        let mut knobs = sweep.knobs.clone();
-        for (k, v) in point {
-            if k == "preset" {
-                knobs.preset = v.clone();
-            }
-        }
-        let mut options = super::options_from(sweep.epsilon, &knobs)?;
-        let render = super::render_options_from(&knobs, &sweep.render)?;
-        let mut extra = Extra {
-            supersample: render.supersample,
-            direct_rays: match render.direct {
-                meshlight::Direct::Interpolated => 0,
-                meshlight::Direct::Traced { light_samples } => light_samples,
-            },
-            gather_rays: render.gather_rays,
-            glossy_rays: render.glossy_rays,
-            patch_size: sweep.render.patch_size,
-            spp: sweep.render.spp,
-            block: sweep.block,
-            backend: super::backend_from(&sweep.knobs),
-        };
-        for (k, v) in point {
-            apply(k, v, &mut options, &mut extra)?;
-        }
-        runs.push((point, options, extra));
-    }
+    let runs = plan(&points, sweep)?;
     let keys: Vec<&str> = sweep.vary.iter().map(|(k, _)| k.as_str()).collect();
     println!(
         "sweep of {} on {} at {}x{}: {} run(s) of {}{}",
@@ -295,47 +260,120 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
         rows.push(row);
     }
     mark_pareto(&mut rows);
-    let mut curve = Vec::new();
-    if sweep.pathtrace_curve && sweep.method != Method::Pathtrace {
+    let curve = if sweep.pathtrace_curve && sweep.method != Method::Pathtrace {
         let slowest = rows.iter().map(|r| r.total).fold(0.0, f64::max);
-        let budget = sweep.pathtrace_seconds.unwrap_or((2.0 * slowest).max(1.0));
-        let mut options = super::options_from(sweep.epsilon, &sweep.knobs)?;
-        // A reference is usually path traced with the same seed: its samples would then
-        // include the curve's own, and the curve would meet it too soon. Another stream.
-        options.seed = options.seed.wrapping_add(CURVE_SEED);
-        let vis = built(&mut backends, &scene, super::backend_from(&sweep.knobs))?;
-        let mut spp = 2u32;
-        while spp <= sweep.max_spp.max(2) {
-            let extra = Extra {
-                supersample: 1,
-                direct_rays: 0,
-                gather_rays: 0,
-                glossy_rays: 0,
-                patch_size: None,
-                spp,
-                block: sweep.block,
-                backend: super::backend_from(&sweep.knobs),
-            };
-            let row = measure(&scene, vis, reference, Method::Pathtrace, &options, &extra)?;
-            println!(
-                "path tracer {spp} spp: {:.3} s, MAE/mean {:.3}%, bias {:+.3}%",
-                row.total,
-                100.0 * row.error.mae_over_mean,
-                100.0 * row.error.bias
-            );
-            let total = row.total;
-            curve.push(row);
-            match spp.checked_mul(2) {
-                Some(next) if total <= budget => spp = next,
-                _ => break,
-            }
-        }
-    }
+        pathtrace_curve(&scene, reference, sweep, slowest, &mut backends)?
+    } else {
+        Vec::new()
+    };
     let csv = sweep.out.with_extension("csv");
     std::fs::write(&csv, to_csv(&keys, &rows, &curve))
         .with_context(|| format!("cannot write {}", csv.display()))?;
     let png = sweep.out.with_extension("png");
     plot(&png, &scene, sweep.method, &rows, &curve)?;
+    print_front(&keys, &rows);
+    println!("wrote {} and {}", csv.display(), png.display());
+    Ok(())
+}
+
+/// Checks every setting before the first run: the block size against the reference, and that
+/// the method uses every setting varied.
+fn check(reference: &Image, sweep: &Sweep) -> Result<()> {
+    if sweep.block != 1 {
+        meshlight::metrics::block_average(reference, sweep.block)?;
+    }
+    for (key, _) in &sweep.vary {
+        if !used_by(sweep.method, key) {
+            bail!(
+                "--vary {key}: the {} method does not use it",
+                method_name(sweep.method)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Each point of the grid as a run: its options and the render's settings, the preset first,
+/// then the point's other values.
+fn plan<'p>(points: &'p [Point], sweep: &Sweep) -> Result<Vec<(&'p Point, Options, Extra)>> {
+    let mut runs = Vec::with_capacity(points.len());
+    for point in points {
+        let mut knobs = sweep.knobs.clone();
+        for (k, v) in point {
+            if k == "preset" {
+                knobs.preset = v.clone();
+            }
+        }
+        let mut options = super::options_from(sweep.epsilon, &knobs)?;
+        let render = super::render_options_from(&knobs, &sweep.render)?;
+        let mut extra = Extra {
+            supersample: render.supersample,
+            direct_rays: match render.direct {
+                meshlight::Direct::Interpolated => 0,
+                meshlight::Direct::Traced { light_samples } => light_samples,
+            },
+            gather_rays: render.gather_rays,
+            glossy_rays: render.glossy_rays,
+            patch_size: sweep.render.patch_size,
+            spp: sweep.render.spp,
+            block: sweep.block,
+            backend: super::backend_from(&sweep.knobs),
+        };
+        for (k, v) in point {
+            apply(k, v, &mut options, &mut extra)?;
+        }
+        runs.push((point, options, extra));
+    }
+    Ok(runs)
+}
+
+/// The path tracer's curve: samples per pixel doubling from 2 up to `--max-spp`, or until a
+/// render takes longer than `--pathtrace-seconds` (default: twice the `slowest` run). A
+/// reference is usually path traced with the same seed: its samples would then include the
+/// curve's own, and the curve would meet it too soon, so the curve takes another stream.
+fn pathtrace_curve(
+    scene: &Scene,
+    reference: &Image,
+    sweep: &Sweep,
+    slowest: f64,
+    backends: &mut HashMap<Backend, Box<dyn Visibility>>,
+) -> Result<Vec<Row>> {
+    let mut curve = Vec::new();
+    let budget = sweep.pathtrace_seconds.unwrap_or((2.0 * slowest).max(1.0));
+    let mut options = super::options_from(sweep.epsilon, &sweep.knobs)?;
+    options.seed = options.seed.wrapping_add(CURVE_SEED);
+    let vis = built(backends, scene, super::backend_from(&sweep.knobs))?;
+    let mut spp = 2u32;
+    while spp <= sweep.max_spp.max(2) {
+        let extra = Extra {
+            supersample: 1,
+            direct_rays: 0,
+            gather_rays: 0,
+            glossy_rays: 0,
+            patch_size: None,
+            spp,
+            block: sweep.block,
+            backend: super::backend_from(&sweep.knobs),
+        };
+        let row = measure(scene, vis, reference, Method::Pathtrace, &options, &extra)?;
+        println!(
+            "path tracer {spp} spp: {:.3} s, MAE/mean {:.3}%, bias {:+.3}%",
+            row.total,
+            100.0 * row.error.mae_over_mean,
+            100.0 * row.error.bias
+        );
+        let total = row.total;
+        curve.push(row);
+        match spp.checked_mul(2) {
+            Some(next) if total <= budget => spp = next,
+            _ => break,
+        }
+    }
+    Ok(curve)
+}
+
+/// The Pareto front, fastest first.
+fn print_front(keys: &[&str], rows: &[Row]) {
     println!("Pareto front (no run both faster and more accurate):");
     let mut front: Vec<&Row> = rows.iter().filter(|r| r.pareto).collect();
     front.sort_by(|a, b| a.total.total_cmp(&b.total));
@@ -352,8 +390,6 @@ pub fn run(scene: &Scene, reference: &Image, sweep: &Sweep) -> Result<()> {
             100.0 * r.error.mae_over_mean
         );
     }
-    println!("wrote {} and {}", csv.display(), png.display());
-    Ok(())
 }
 
 /// The backend `b` over the scene, built once per sweep.

@@ -4,10 +4,9 @@
 
 use glam::{DVec3, Vec3};
 
-use super::suns::{self, SunLattice};
-use super::{AnnualOptions, Frame};
+use super::suns;
+use super::{AnnualOptions, Dome};
 use crate::daylight::entering::{Entering, Escape};
-use crate::daylight::patches::Patches;
 use crate::error::{Error, Result};
 use crate::light::DirectLight;
 use crate::parallel::for_chunks;
@@ -45,9 +44,10 @@ pub(super) fn coefficients(
     solution: &Solution,
     vis: &dyn Visibility,
     options: &AnnualOptions,
-    (frame, coarse, fine, lattice): (&Frame, &Patches, &Patches, &SunLattice),
+    dome: &Dome,
     reporter: &mut Reporter,
 ) -> Result<Option<Vec<GridCoefficients>>> {
+    let (frame, coarse, lattice) = (&dome.frame, &dome.coarse, &dome.lattice);
     let threads = options.lux.threads.max(1);
     let seed = options.solver.seed;
     let s = &solution.field.samples;
@@ -63,31 +63,9 @@ pub(super) fn coefficients(
         return Ok(None);
     }
 
-    // The sky straight in at every sample, by coarse patch (the ground last).
-    let entering = Entering::of(lit, crate::solver::SKY_RAYS)
-        .ok_or_else(|| Error::argument("scene", "no daylight to shoot"))?;
+    check_budget(lit, solution, options, bases)?;
     let ground = coarse.len();
-    check_budget(lit, solution, options, coarse.len() + 1 + lattice.len())?;
-    // (patch, sample, light) of every ray that leaves, binned chunk by chunk.
-    let mut escapes: Vec<Vec<(u32, u32, Vec3)>> = vec![Vec::new(); n.div_ceil(256)];
-    for_chunks(&mut escapes, 1, threads, |c, out| {
-        let range = c * 256..((c + 1) * 256).min(n);
-        let (got, _) = entering.escapes(vis, &at[range.clone()], &ids[range.clone()], seed)?;
-        out[0] = got
-            .iter()
-            .map(|e: &Escape| {
-                let p = frame
-                    .sky_angles(e.dir)
-                    .map_or(ground, |(alt, az)| coarse.of(alt, az));
-                (p as u32, e.receiver + range.start as u32, e.light.as_vec3())
-            })
-            .collect();
-        Ok(())
-    })?;
-    let mut by_patch: Vec<Vec<(u32, Vec3)>> = vec![Vec::new(); coarse.len() + 1];
-    for (p, k, light) in escapes.into_iter().flatten() {
-        by_patch[p as usize].push((k, light));
-    }
+    let by_patch = sky_by_patch(lit, vis, options, dome, (&at, &ids))?;
 
     // Each grid's light straight in (fine patches) and its gather rows.
     let grid_entering = Entering::of(lit, crate::lux::GRID_SKY_RAYS)
@@ -95,15 +73,8 @@ pub(super) fn coefficients(
     let mut grids = Vec::new();
     let mut rows = Vec::new();
     for grid in lit.grids() {
-        let (coefficients, gather) = grid_coefficients(
-            lit,
-            solution,
-            vis,
-            grid,
-            &grid_entering,
-            (frame, fine),
-            options,
-        )?;
+        let (coefficients, gather) =
+            grid_coefficients(lit, solution, vis, grid, &grid_entering, dome, options)?;
         grids.push(GridCoefficients {
             bounced: vec![0.0; coefficients.points.len() * (coarse.len() + 1)],
             sun_bounced: vec![0.0; coefficients.points.len() * lattice.len()],
@@ -169,6 +140,45 @@ pub(super) fn coefficients(
     Ok(Some(grids))
 }
 
+/// The sky straight in at every sample (`at`, with its ids), binned by coarse patch (the ground
+/// last): per patch, (sample, light) of every ray that leaves through it.
+fn sky_by_patch(
+    lit: &Scene,
+    vis: &dyn Visibility,
+    options: &AnnualOptions,
+    dome: &Dome,
+    (at, ids): (&[(Vec3, Vec3)], &[u32]),
+) -> Result<Vec<Vec<(u32, Vec3)>>> {
+    let (frame, coarse) = (&dome.frame, &dome.coarse);
+    let (threads, seed) = (options.lux.threads.max(1), options.solver.seed);
+    let n = at.len();
+    let entering = Entering::of(lit, crate::solver::SKY_RAYS)
+        .ok_or_else(|| Error::argument("scene", "no daylight to shoot"))?;
+    let ground = coarse.len();
+    // (patch, sample, light) of every ray that leaves, binned chunk by chunk.
+    let mut escapes: Vec<Vec<(u32, u32, Vec3)>> = vec![Vec::new(); n.div_ceil(256)];
+    for_chunks(&mut escapes, 1, threads, |c, out| {
+        let range = c * 256..((c + 1) * 256).min(n);
+        let (got, _) = entering.escapes(vis, &at[range.clone()], &ids[range.clone()], seed)?;
+        out[0] = got
+            .iter()
+            .map(|e: &Escape| {
+                let p = frame
+                    .sky_angles(e.dir)
+                    .map_or(ground, |(alt, az)| coarse.of(alt, az));
+                (p as u32, e.receiver + range.start as u32, e.light.as_vec3())
+            })
+            .collect();
+        Ok(())
+    })?;
+    let mut by_patch: Vec<Vec<(u32, Vec3)>> = vec![Vec::new(); coarse.len() + 1];
+    for (p, k, light) in escapes.into_iter().flatten() {
+        by_patch[p as usize].push((k, light));
+    }
+
+    Ok(by_patch)
+}
+
 /// Bytes a sample's sky rays may hold while they are binned by patch: every one of its rays
 /// leaving (a patch, a sample and an RGB light each, twice while they are sorted).
 const ESCAPE_BYTES_PER_SAMPLE: usize = 2 * 20 * crate::solver::SKY_RAYS as usize;
@@ -221,9 +231,10 @@ fn grid_coefficients(
     vis: &dyn Visibility,
     grid: &Grid,
     entering: &Entering,
-    (frame, fine): (&Frame, &Patches),
+    dome: &Dome,
     options: &AnnualOptions,
 ) -> Result<(GridCoefficients, Vec<Vec<(u32, Vec3)>>)> {
+    let (frame, fine) = (&dome.frame, &dome.fine);
     let points = grid.points();
     let normal = grid.normal;
     let at: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, normal)).collect();

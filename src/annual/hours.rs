@@ -5,8 +5,7 @@
 use glam::Vec3;
 
 use super::coefficients::GridCoefficients;
-use super::suns::SunLattice;
-use super::{Frame, HourStamp};
+use super::{Dome, Frame, HourStamp};
 use crate::daylight::epw::Weather;
 use crate::daylight::patches::Patches;
 use crate::daylight::spa::{delta_t, sun_position, LocalTime, Observer};
@@ -169,11 +168,12 @@ impl SkyPoints {
 pub(super) fn hour_values(
     hour: &Hour,
     grids: &[GridCoefficients],
-    (frame, sky_points, lattice): (&Frame, &SkyPoints, &SunLattice),
+    dome: &Dome,
     sun_light: &mut DirectLight,
     vis: &dyn Visibility,
     lux: &LuxOptions,
 ) -> Result<Vec<(Vec<f32>, Vec<f32>)>> {
+    let (frame, sky_points, lattice) = (&dome.frame, &dome.points, &dome.lattice);
     let (Some((zenith, azimuth)), Some((dn, dh))) = (hour.sun, hour.light) else {
         return Ok(Vec::new());
     };

@@ -28,6 +28,7 @@ use glam::{DVec3, Vec3};
 
 use crate::daylight::epw::Weather;
 use crate::daylight::patches::Patches;
+use crate::daylight::AnnualSettings;
 use crate::error::{Error, Result};
 use crate::light::DirectLight;
 use crate::lux::LuxOptions;
@@ -116,6 +117,23 @@ struct Frame {
 }
 
 impl Frame {
+    /// The site of `settings`, each figure it leaves out taken from the weather file.
+    fn of(settings: &AnnualSettings, weather: &Weather) -> Frame {
+        let site = &settings.site;
+        let up = site.up.as_dvec3().normalize_or_zero();
+        let north = site.north.as_dvec3();
+        let north = (north - up * north.dot(up)).normalize_or_zero();
+        Frame {
+            latitude: site.latitude.unwrap_or(weather.site.latitude),
+            longitude: site.longitude.unwrap_or(weather.site.longitude),
+            timezone: site.timezone.unwrap_or(weather.site.timezone),
+            up,
+            north,
+            east: north.cross(up),
+            ground_reflectance: site.ground_reflectance,
+        }
+    }
+
     /// (altitude, azimuth) in degrees of a scene direction; `None` below the horizon.
     fn sky_angles(&self, dir: Vec3) -> Option<(f64, f64)> {
         let d = dir.as_dvec3().normalize_or_zero();
@@ -162,39 +180,9 @@ fn run(
     options: &AnnualOptions,
     progress: Callback,
 ) -> Result<Year> {
-    let Some(settings) = scene.annual() else {
-        return Err(Error::argument(
-            "scene",
-            format!(
-                "{} has no [annual]: a year of weather needs its weather file",
-                scene.path().display()
-            ),
-        ));
-    };
-    if scene.grids().is_empty() {
-        return Err(Error::argument(
-            "scene",
-            format!(
-                "{} has no [[grid]]: a year is measured at grid points",
-                scene.path().display()
-            ),
-        ));
-    }
-    let site = &settings.site;
-    let up = site.up.as_dvec3().normalize_or_zero();
-    let north = site.north.as_dvec3();
-    let north = (north - up * north.dot(up)).normalize_or_zero();
-    let frame = Frame {
-        latitude: site.latitude.unwrap_or(weather.site.latitude),
-        longitude: site.longitude.unwrap_or(weather.site.longitude),
-        timezone: site.timezone.unwrap_or(weather.site.timezone),
-        up,
-        north,
-        east: north.cross(up),
-        ground_reflectance: site.ground_reflectance,
-    };
-    let hours = hours(weather, &frame, settings);
-
+    let settings = settings_of(scene)?;
+    let dome = Dome::new(Frame::of(settings, weather), settings.sky_subdivision);
+    let hours = hours(weather, &dome.frame, settings);
     // The solve, under an overcast sky: samples, areas, links, row scales.
     let mut lit = scene.clone();
     lit.set_daylight(Some(settings.overcast()?));
@@ -213,24 +201,11 @@ fn run(
     if year.stopped {
         return Ok(year);
     }
-
-    let coarse = Patches::new(settings.sky_subdivision);
-    let fine = Patches::new(settings.sky_subdivision.max(DIRECT_SUBDIVISION));
-    let lattice = SunLattice::new(frame.latitude);
-    let sky = SkyPoints::new(&fine, &coarse);
-    let Some(grids) = coefficients(
-        lit,
-        &solution,
-        vis,
-        options,
-        (&frame, &coarse, &fine, &lattice),
-        &mut reporter,
-    )?
-    else {
+    let Some(grids) = coefficients(lit, &solution, vis, options, &dome, &mut reporter)? else {
         year.stopped = true;
         return Ok(year);
     };
-    year.bases = coarse.len() + 1 + lattice.len();
+    year.bases = dome.coarse.len() + 1 + dome.lattice.len();
     year.coefficient_bytes = grids
         .iter()
         .map(|g| {
@@ -238,72 +213,170 @@ fn run(
                 + g.direct.iter().map(|d| 8 * d.len()).sum::<usize>()
         })
         .sum();
-
-    // Every hour with the sun up and weather to light it.
-    let lit_hours: Vec<usize> = (0..hours.len())
-        .filter(|&h| hours[h].sun.is_some() && hours[h].light.is_some())
-        .collect();
     year.left_out = hours
         .iter()
         .filter(|h| h.sun.is_some() && h.light.is_none())
         .count();
-    let mut values: Vec<Vec<(Vec<f32>, Vec<f32>)>> = vec![Vec::new(); lit_hours.len()];
-    let base = Progress {
-        items: lit_hours.len(),
-        ..Progress::of(Phase::Hours)
+    let lighting = Lighting {
+        lit,
+        vis,
+        grids: &grids,
+        dome: &dome,
+        options,
     };
-    let finished = if reporter.report(base) {
-        false
-    } else {
-        let work = |first: usize, out: &mut [Vec<(Vec<f32>, Vec<f32>)>]| {
-            let mut sun = DirectLight::unit_sun(lit, options.lux.light_samples, Vec3::Y);
-            for (o, &h) in out.iter_mut().zip(&lit_hours[first..]) {
-                *o = hour_values(
-                    &hours[h],
-                    &grids,
-                    (&frame, &sky, &lattice),
-                    &mut sun,
-                    vis,
-                    &options.lux,
-                )?;
-            }
-            Ok(())
-        };
-        let threads = options.lux.threads.max(1);
-        crate::parallel::for_chunks_reporting(
-            &mut values,
-            16,
-            threads,
-            work,
-            &mut reporter.part(base),
-        )?
-    };
+    let (lit_hours, values, finished) = lighting.hours(&hours, &mut reporter)?;
     let done = if finished {
         values.len()
     } else {
         year.stopped = true;
         values.iter().take_while(|v| !v.is_empty()).count()
     };
+    // A stopped year counts the hours up to the first lit one not done.
+    let limit = lit_hours.get(done).copied().unwrap_or(hours.len());
+    tally(
+        &mut year,
+        &hours[..limit],
+        &lit_hours[..done],
+        &values,
+        &grids,
+        options.hourly,
+    );
+    Ok(year)
+}
 
-    // The metrics, hour by hour in the file's order.
+/// The scene's `[annual]`, where it has one and grids to measure it at.
+fn settings_of(scene: &Scene) -> Result<&AnnualSettings> {
+    let Some(settings) = scene.annual() else {
+        return Err(Error::argument(
+            "scene",
+            format!(
+                "{} has no [annual]: a year of weather needs its weather file",
+                scene.path().display()
+            ),
+        ));
+    };
+    if scene.grids().is_empty() {
+        return Err(Error::argument(
+            "scene",
+            format!(
+                "{} has no [[grid]]: a year is measured at grid points",
+                scene.path().display()
+            ),
+        ));
+    }
+    Ok(settings)
+}
+
+/// The sky as a year of weather divides it: the site's frame, the coarse patches the
+/// coefficients are taken on, the fine ones the light straight in is binned on, the sun
+/// lattice, and the points each hour's sky is read at.
+struct Dome {
+    frame: Frame,
+    coarse: Patches,
+    fine: Patches,
+    lattice: SunLattice,
+    points: SkyPoints,
+}
+
+impl Dome {
+    fn new(frame: Frame, subdivision: u32) -> Dome {
+        let coarse = Patches::new(subdivision);
+        let fine = Patches::new(subdivision.max(DIRECT_SUBDIVISION));
+        let lattice = SunLattice::new(frame.latitude);
+        let points = SkyPoints::new(&fine, &coarse);
+        Dome {
+            frame,
+            coarse,
+            fine,
+            lattice,
+            points,
+        }
+    }
+}
+
+/// What lighting the year's hours takes.
+struct Lighting<'a> {
+    lit: &'a Scene,
+    vis: &'a dyn Visibility,
+    grids: &'a [coefficients::GridCoefficients],
+    dome: &'a Dome,
+    options: &'a AnnualOptions,
+}
+
+/// One hour's illuminance and direct sunlight at each grid's points.
+type HourValues = Vec<(Vec<f32>, Vec<f32>)>;
+
+impl Lighting<'_> {
+    /// Every hour with the sun up and weather to light it: which hours, their values (empty
+    /// where a Stop left them undone) and whether all were done.
+    fn hours(
+        &self,
+        hours: &[hours::Hour],
+        reporter: &mut Reporter,
+    ) -> Result<(Vec<usize>, Vec<HourValues>, bool)> {
+        let lit_hours: Vec<usize> = (0..hours.len())
+            .filter(|&h| hours[h].sun.is_some() && hours[h].light.is_some())
+            .collect();
+        let mut values: Vec<HourValues> = vec![Vec::new(); lit_hours.len()];
+        let base = Progress {
+            items: lit_hours.len(),
+            ..Progress::of(Phase::Hours)
+        };
+        if reporter.report(base) {
+            return Ok((lit_hours, values, false));
+        }
+        let options = self.options;
+        let work = |first: usize, out: &mut [HourValues]| {
+            let mut sun = DirectLight::unit_sun(self.lit, options.lux.light_samples, Vec3::Y);
+            for (o, &h) in out.iter_mut().zip(&lit_hours[first..]) {
+                *o = hour_values(
+                    &hours[h],
+                    self.grids,
+                    self.dome,
+                    &mut sun,
+                    self.vis,
+                    &options.lux,
+                )?;
+            }
+            Ok(())
+        };
+        let threads = options.lux.threads.max(1);
+        let finished = crate::parallel::for_chunks_reporting(
+            &mut values,
+            16,
+            threads,
+            work,
+            &mut reporter.part(base),
+        )?;
+        Ok((lit_hours, values, finished))
+    }
+}
+
+/// The metrics, hour by hour in the file's order, into `year`: the lit hours done
+/// (`lit_done`, indices into `hours`, with their `values`) and the nights among `hours`.
+fn tally(
+    year: &mut Year,
+    hours: &[hours::Hour],
+    lit_done: &[usize],
+    values: &[HourValues],
+    grids: &[coefficients::GridCoefficients],
+    hourly: bool,
+) {
     let mut tallies: Vec<Tally> = grids
         .iter()
         .map(|g| Tally::new(g.counted.clone(), g.target))
         .collect();
-    let mut hourly: Vec<Vec<f32>> = vec![Vec::new(); grids.len()];
+    let mut by_hour: Vec<Vec<f32>> = vec![Vec::new(); grids.len()];
     let mut next = 0;
-    let lit_done = &lit_hours[..done];
-    // A stopped year counts the hours up to the first not done.
-    let limit = lit_hours.get(done).copied().unwrap_or(hours.len());
-    for (h, hour) in hours.iter().enumerate().take(limit) {
+    for (h, hour) in hours.iter().enumerate() {
         if next < lit_done.len() && lit_done[next] == h {
             year.sun_hours.push(hour.stamp);
             for (g, (e, s)) in values[next].iter().enumerate() {
                 let e64: Vec<f64> = e.iter().map(|&v| f64::from(v)).collect();
                 let s64: Vec<f64> = s.iter().map(|&v| f64::from(v)).collect();
                 tallies[g].add(&e64, &s64, hour.occupied, true);
-                if options.hourly {
-                    hourly[g].extend_from_slice(e);
+                if hourly {
+                    by_hour[g].extend_from_slice(e);
                 }
             }
             next += 1;
@@ -315,7 +388,7 @@ fn run(
             }
         }
     }
-    for ((g, tally), hourly) in grids.iter().zip(&tallies).zip(hourly) {
+    for ((g, tally), hourly) in grids.iter().zip(&tallies).zip(by_hour) {
         let (metrics, summary) = tally.finish();
         year.grids.push(GridYear {
             name: g.name.clone(),
@@ -325,5 +398,4 @@ fn run(
             hourly,
         });
     }
-    Ok(year)
 }

@@ -237,95 +237,134 @@ impl<'a> Entering<'a> {
         // Per ray: cos θ at the receiver over the mixture's density × rays (the weight of
         // its light), 0 where it points below the receiver's horizon.
         let mut weights: Vec<f64> = Vec::with_capacity(points.len() * n_rays);
-        let mut solid: Vec<f64> = Vec::new();
         for (&(x, n), &id) in points.iter().zip(ids) {
-            let from = x + self.lift * n;
             let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, SALT));
-            // Each portal's weight: its solid angle from the receiver times the cosine there,
-            // roughly (a near portal is held to its area so the weight stays finite).
-            solid.clear();
-            let mut total = 0.0;
-            for p in &self.portals {
-                let front = p.vertices.iter().any(|&v| (v - from).dot(n) > 0.0);
-                let w = if front {
-                    let d = p.centroid - from;
-                    let d2 = d.length_squared().max(p.area);
-                    let dir = d / d.length().max(1e-12);
-                    f64::from(p.area * p.normal.dot(dir).abs() * dir.dot(n).max(0.05) / d2)
-                } else {
-                    0.0
-                };
-                total += w;
-                solid.push(total);
-            }
-            let aimed = if total > 0.0 {
-                (PORTAL_SHARE * n_rays as f64).round() as usize
+            self.draw(x, n, &mut rng, &mut dirs, &mut weights);
+        }
+        let (shares, live, queries) = self.leaving(vis, points, &dirs, &weights)?;
+        let escapes = live
+            .into_iter()
+            .filter(|&i| shares[i] != DVec3::ZERO)
+            .map(|i| Escape {
+                receiver: (i / n_rays) as u32,
+                dir: dirs[i],
+                light: shares[i] * weights[i],
+            })
+            .collect();
+        Ok((escapes, queries))
+    }
+
+    /// A receiver's `rays` directions (at `x`, normal `n`) and their weights, appended: some
+    /// aimed at the portals in proportion to each one's weight and spread over its area, the
+    /// rest cosine-weighted over the hemisphere. Both ways draw from Fibonacci lattices shifted
+    /// at random per receiver (as even as a grid for any count, and unbiased); each ray's
+    /// weight is cos θ over the mixture's density.
+    fn draw(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        rng: &mut Pcg64Mcg,
+        dirs: &mut Vec<Vec3>,
+        weights: &mut Vec<f64>,
+    ) {
+        let n_rays = self.rays as usize;
+        let from = x + self.lift * n;
+        // Each portal's weight: its solid angle from the receiver times the cosine there,
+        // roughly (a near portal is held to its area so the weight stays finite).
+        let mut solid: Vec<f64> = Vec::with_capacity(self.portals.len());
+        let mut total = 0.0;
+        for p in &self.portals {
+            let front = p.vertices.iter().any(|&v| (v - from).dot(n) > 0.0);
+            let w = if front {
+                let d = p.centroid - from;
+                let d2 = d.length_squared().max(p.area);
+                let dir = d / d.length().max(1e-12);
+                f64::from(p.area * p.normal.dot(dir).abs() * dir.dot(n).max(0.05) / d2)
             } else {
-                0
+                0.0
             };
-            let spread = n_rays - aimed;
-            let (t, b) = n.any_orthonormal_pair();
-            // Both ways draw from Fibonacci lattices shifted at random per receiver (as even
-            // as a grid for any count, and unbiased): the portals' rays spread over the
-            // portals in proportion and over each portal's area, the rest over the
-            // hemisphere.
-            let shift = (rng.random::<f64>(), rng.random::<f64>());
-            for i in 0..n_rays {
-                let dir = if i < aimed {
-                    let (u1, u2) = lattice(i as u32, aimed as u32, shift);
-                    let pick = u1 * total;
-                    let j = solid.partition_point(|&c| c <= pick).min(solid.len() - 1);
-                    // Where in its share of the line the pick fell: the point's first
-                    // coordinate, so the portal's rays stay stratified over it.
-                    let below = if j == 0 { 0.0 } else { solid[j - 1] };
-                    let within = ((pick - below) / (solid[j] - below)).clamp(0.0, 1.0);
-                    let p = &self.portals[j];
-                    let at = crate::sampling::triangles::in_triangle(p.vertices, within, u2);
-                    (at - from).normalize_or_zero()
-                } else {
-                    // Cosine-weighted over the receiver's hemisphere.
-                    let (u, v) = lattice((i - aimed) as u32, spread as u32, shift);
-                    let phi = std::f64::consts::TAU * v;
-                    let r = u.sqrt();
-                    (t * (r * phi.cos()) as f32
-                        + b * (r * phi.sin()) as f32
-                        + n * (1.0 - u).max(0.0).sqrt() as f32)
-                        .normalize_or_zero()
-                };
-                let cos = f64::from(dir.dot(n));
-                let weight = if cos > 0.0 {
-                    // The density of drawing `dir` either way, times the rays drawn so.
-                    let mut portal_pdf = 0.0;
-                    if aimed > 0 {
-                        let mut below = 0.0;
-                        for (p, &c) in self.portals.iter().zip(&solid) {
-                            let w = c - below;
-                            below = c;
-                            if w <= 0.0 {
-                                continue;
-                            }
-                            if let Some(t) = crossing(from, dir, p.vertices) {
-                                let cos_p = f64::from(p.normal.dot(dir).abs()).max(1e-9);
-                                portal_pdf += w / total * f64::from(t) * f64::from(t)
-                                    / (f64::from(p.area) * cos_p);
-                            }
-                        }
-                    }
-                    let density =
-                        spread as f64 * cos / std::f64::consts::PI + aimed as f64 * portal_pdf;
-                    if density > 0.0 {
-                        cos / density
-                    } else {
-                        0.0
-                    }
+            total += w;
+            solid.push(total);
+        }
+        let aimed = if total > 0.0 {
+            (PORTAL_SHARE * n_rays as f64).round() as usize
+        } else {
+            0
+        };
+        let spread = n_rays - aimed;
+        let (t, b) = n.any_orthonormal_pair();
+        let shift = (rng.random::<f64>(), rng.random::<f64>());
+        for i in 0..n_rays {
+            let dir = if i < aimed {
+                let (u1, u2) = lattice(i as u32, aimed as u32, shift);
+                let pick = u1 * total;
+                let j = solid.partition_point(|&c| c <= pick).min(solid.len() - 1);
+                // Where in its share of the line the pick fell: the point's first coordinate,
+                // so the portal's rays stay stratified over it.
+                let below = if j == 0 { 0.0 } else { solid[j - 1] };
+                let within = ((pick - below) / (solid[j] - below)).clamp(0.0, 1.0);
+                let p = &self.portals[j];
+                let at = crate::sampling::triangles::in_triangle(p.vertices, within, u2);
+                (at - from).normalize_or_zero()
+            } else {
+                // Cosine-weighted over the receiver's hemisphere.
+                let (u, v) = lattice((i - aimed) as u32, spread as u32, shift);
+                let phi = std::f64::consts::TAU * v;
+                let r = u.sqrt();
+                (t * (r * phi.cos()) as f32
+                    + b * (r * phi.sin()) as f32
+                    + n * (1.0 - u).max(0.0).sqrt() as f32)
+                    .normalize_or_zero()
+            };
+            let cos = f64::from(dir.dot(n));
+            let weight = if cos > 0.0 {
+                let density = spread as f64 * cos / std::f64::consts::PI
+                    + aimed as f64 * self.portal_pdf(from, dir, &solid, total, aimed);
+                if density > 0.0 {
+                    cos / density
                 } else {
                     0.0
-                };
-                dirs.push(dir);
-                weights.push(weight);
+                }
+            } else {
+                0.0
+            };
+            dirs.push(dir);
+            weights.push(weight);
+        }
+    }
+
+    /// The density of drawing `dir` from `from` by way of the portals (cumulative weights
+    /// `solid`, summing to `total`), where any ray is aimed at them.
+    fn portal_pdf(&self, from: Vec3, dir: Vec3, solid: &[f64], total: f64, aimed: usize) -> f64 {
+        let mut portal_pdf = 0.0;
+        if aimed > 0 {
+            let mut below = 0.0;
+            for (p, &c) in self.portals.iter().zip(solid) {
+                let w = c - below;
+                below = c;
+                if w <= 0.0 {
+                    continue;
+                }
+                if let Some(t) = crossing(from, dir, p.vertices) {
+                    let cos_p = f64::from(p.normal.dot(dir).abs()).max(1e-9);
+                    portal_pdf +=
+                        w / total * f64::from(t) * f64::from(t) / (f64::from(p.area) * cos_p);
+                }
             }
         }
-        // Which rays leave the model, and what glass passes.
+        portal_pdf
+    }
+
+    /// Which of the rays (weighted, those of weight 0 left out) leave the model, and what
+    /// glass passes of each: per ray its share, the rays traced, and the queries.
+    fn leaving(
+        &self,
+        vis: &dyn Visibility,
+        points: &[(Vec3, Vec3)],
+        dirs: &[Vec3],
+        weights: &[f64],
+    ) -> Result<(Vec<DVec3>, Vec<usize>, u64)> {
+        let n_rays = self.rays as usize;
         let mut shares = vec![DVec3::ZERO; dirs.len()];
         let mut queries = 0;
         let live: Vec<usize> = (0..dirs.len()).filter(|&i| weights[i] > 0.0).collect();
@@ -374,16 +413,7 @@ impl<'a> Entering<'a> {
                 }
             }
         }
-        let escapes = live
-            .into_iter()
-            .filter(|&i| shares[i] != DVec3::ZERO)
-            .map(|i| Escape {
-                receiver: (i / n_rays) as u32,
-                dir: dirs[i],
-                light: shares[i] * weights[i],
-            })
-            .collect();
-        Ok((escapes, queries))
+        Ok((shares, live, queries))
     }
 }
 

@@ -268,6 +268,32 @@ struct AreaSample {
     area_pdf: f64,
 }
 
+impl PathOptions {
+    /// Checks the path tracer's settings: the first out of its range, as
+    /// [`Error::Option`](crate::Error::Option) naming it.
+    pub fn validate(&self) -> Result<()> {
+        if self.spp < 2 {
+            return Err(Error::Option {
+                option: "spp",
+                problem: format!(
+                    "{} is fewer than 2 (one sample for each half-image)",
+                    self.spp
+                ),
+            });
+        }
+        if self.mirror_depth > MAX_MIRROR_DEPTH {
+            return Err(Error::Option {
+                option: "mirror_depth",
+                problem: format!(
+                    "{} is more than {MAX_MIRROR_DEPTH} mirrors in a row",
+                    self.mirror_depth
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Renders the scene's camera view by path tracing. `progress` hears every pass
 /// ([`Phase::Tracing`]: `items` the samples per pixel wanted, `shots` those done) and may stop
 /// the render after a pass that leaves an even number of samples per pixel (each half-image
@@ -281,24 +307,7 @@ pub fn path_trace(
     crate::parallel::guarded("the path tracer", || {
         let checked = crate::visibility::Checked::new(vis, scene);
         let vis: &dyn crate::visibility::Visibility = &checked;
-        if options.spp < 2 {
-            return Err(Error::Option {
-                option: "spp",
-                problem: format!(
-                    "{} is fewer than 2 (one sample for each half-image)",
-                    options.spp
-                ),
-            });
-        }
-        if options.mirror_depth > MAX_MIRROR_DEPTH {
-            return Err(Error::Option {
-                option: "mirror_depth",
-                problem: format!(
-                    "{} is more than {MAX_MIRROR_DEPTH} mirrors in a row",
-                    options.mirror_depth
-                ),
-            });
-        }
+        options.validate()?;
         scene.camera.check()?;
         // The two half-sums, the three images returned.
         let per_pixel = std::mem::size_of::<[DVec3; 2]>() + 3 * std::mem::size_of::<Vec3>();
@@ -369,32 +378,46 @@ pub fn path_trace(
                 }
             }
         }
-        let image_of = |f: &dyn Fn(&[DVec3; 2]) -> DVec3| Image {
-            width: w as u32,
-            height: h as u32,
-            pixels: sums.iter().map(|s| f(s).as_vec3()).collect(),
-        };
-        let half = f64::from(done / 2);
-        let odd = f64::from(done - done / 2);
-        let image = image_of(&|s| (s[0] + s[1]) / f64::from(done));
-        let halves = [image_of(&|s| s[0] / half), image_of(&|s| s[1] / odd)];
-        let mean = image.mean();
-        let diff: f64 = halves[0]
-            .pixels
-            .iter()
-            .zip(&halves[1].pixels)
-            .map(|(a, b)| f64::from((*a - *b).abs().element_sum()))
-            .sum::<f64>()
-            / (3 * pixels.max(1)) as f64;
-        Ok(PathImage {
-            image,
-            halves,
-            spp: done,
-            noise: if mean > 0.0 { diff / 2.0 / mean } else { 0.0 },
-            rays: *rays.get_mut(),
-            stopped,
-        })
+        let rays = *rays.get_mut();
+        Ok(finish(&sums, (w, h), done, rays, stopped))
     })
+}
+
+/// The image from the sums of the even and of the odd samples (`done` in all), and its noise:
+/// the two half-images' mean difference, halved, over the image's mean.
+fn finish(
+    sums: &[[DVec3; 2]],
+    (w, h): (usize, usize),
+    done: u32,
+    rays: u64,
+    stopped: bool,
+) -> PathImage {
+    let pixels = w * h;
+    let image_of = |f: &dyn Fn(&[DVec3; 2]) -> DVec3| Image {
+        width: w as u32,
+        height: h as u32,
+        pixels: sums.iter().map(|s| f(s).as_vec3()).collect(),
+    };
+    let half = f64::from(done / 2);
+    let odd = f64::from(done - done / 2);
+    let image = image_of(&|s| (s[0] + s[1]) / f64::from(done));
+    let halves = [image_of(&|s| s[0] / half), image_of(&|s| s[1] / odd)];
+    let mean = image.mean();
+    let diff: f64 = halves[0]
+        .pixels
+        .iter()
+        .zip(&halves[1].pixels)
+        .map(|(a, b)| f64::from((*a - *b).abs().element_sum()))
+        .sum::<f64>()
+        / (3 * pixels.max(1)) as f64;
+    PathImage {
+        image,
+        halves,
+        spp: done,
+        noise: if mean > 0.0 { diff / 2.0 / mean } else { 0.0 },
+        rays,
+        stopped,
+    }
 }
 
 /// What tracing reads.
@@ -799,31 +822,15 @@ impl Tracer<'_> {
             -triangle.normal
         };
         let d = dir.as_dvec3().normalize();
-        let kd = if front || surface.two_sided {
-            scene.reflectance_at(hit.triangle, x).as_dvec3()
-        } else {
-            DVec3::ZERO
-        };
-        let (lobe, delta) =
-            match branches(material, d, triangle.normal.as_dvec3(), surface.two_sided) {
-                Branches::None => (None, [None, None]),
-                Branches::Delta(b) => (None, b),
-                Branches::Glossy(l) => {
-                    debug_assert!(
-                        l.normal().dot(n.as_dvec3()) > 0.999,
-                        "the lobe's side is the hit's"
-                    );
-                    (Some(l), [None, None])
-                }
-            };
-        let ks = match material.kind {
-            Kind::Specular { ks, .. } => ks.as_dvec3(),
-            _ => DVec3::ZERO,
-        };
-        let w_diffuse = luminance(kd);
-        let w_lobe = if lobe.is_some() { luminance(ks) } else { 0.0 };
-        let w_delta = delta.map(|b| b.map_or(0.0, |(_, w)| luminance(w)));
-        let total = w_diffuse + w_lobe + w_delta[0] + w_delta[1];
+        let Mixture {
+            kd,
+            lobe,
+            delta,
+            w_diffuse,
+            w_lobe,
+            w_delta,
+            total,
+        } = Mixture::at(scene, hit.triangle, x, d, front);
         if total <= 0.0 {
             return false;
         }
@@ -847,29 +854,7 @@ impl Tracer<'_> {
         }
         let choice = path.rng.random::<f64>() * total;
         if choice < w_diffuse + w_lobe {
-            // A non-delta direction: from the diffuse part or the lobe, weighed by the mixture.
-            let (w, cos) = if choice < w_diffuse {
-                let (d, _) = cosine_direction(path, n);
-                let w = d.as_dvec3().normalize();
-                (w, w.dot(n.as_dvec3()))
-            } else {
-                let (u1, u2): (f64, f64) = (path.rng.random(), path.rng.random());
-                let Some((w, _)) = smooth.lobe.as_ref().and_then(|l| l.sample(u1, u2)) else {
-                    return false;
-                };
-                (w, w.dot(n.as_dvec3()))
-            };
-            let pdf = smooth.pdf(w, cos);
-            if cos <= 0.0 || pdf <= 0.0 {
-                return false;
-            }
-            path.throughput = smooth.value(w, cos) / pdf;
-            if !roulette(path) {
-                return false;
-            }
-            path.bounce_pdf = pdf;
-            leave(path, from, w.as_vec3());
-            return true;
+            return smooth_bounce(path, &smooth, from, choice < w_diffuse);
         }
         let i = if choice < w_diffuse + w_lobe + w_delta[0] || w_delta[1] <= 0.0 {
             0
@@ -918,6 +903,88 @@ impl Tracer<'_> {
         }
         true
     }
+}
+
+/// What a hit scatters into: the diffuse reflectance (where its side reflects), the glossy
+/// lobe, the delta branches, and each part's weight (its luminance) for choosing among them.
+struct Mixture {
+    kd: DVec3,
+    lobe: Option<Lobe>,
+    delta: [Option<(DVec3, DVec3)>; 2],
+    w_diffuse: f64,
+    w_lobe: f64,
+    w_delta: [f64; 2],
+    total: f64,
+}
+
+impl Mixture {
+    /// At point `x` of `triangle`, met along `d` from its front or back.
+    fn at(scene: &Scene, triangle: u32, x: Vec3, d: DVec3, front: bool) -> Mixture {
+        let tri = &scene.triangles[triangle as usize];
+        let surface = &scene.surfaces[tri.surface as usize];
+        let material = &scene.materials[surface.material as usize];
+        let n = if front { tri.normal } else { -tri.normal };
+        let kd = if front || surface.two_sided {
+            scene.reflectance_at(triangle, x).as_dvec3()
+        } else {
+            DVec3::ZERO
+        };
+        let (lobe, delta) = match branches(material, d, tri.normal.as_dvec3(), surface.two_sided) {
+            Branches::None => (None, [None, None]),
+            Branches::Delta(b) => (None, b),
+            Branches::Glossy(l) => {
+                debug_assert!(
+                    l.normal().dot(n.as_dvec3()) > 0.999,
+                    "the lobe's side is the hit's"
+                );
+                (Some(l), [None, None])
+            }
+        };
+        let ks = match material.kind {
+            Kind::Specular { ks, .. } => ks.as_dvec3(),
+            _ => DVec3::ZERO,
+        };
+        let w_diffuse = luminance(kd);
+        let w_lobe = if lobe.is_some() { luminance(ks) } else { 0.0 };
+        let w_delta = delta.map(|b| b.map_or(0.0, |(_, w)| luminance(w)));
+        Mixture {
+            kd,
+            lobe,
+            delta,
+            w_diffuse,
+            w_lobe,
+            w_delta,
+            total: w_diffuse + w_lobe + w_delta[0] + w_delta[1],
+        }
+    }
+}
+
+/// A non-delta bounce from `from`: a direction from the diffuse part (`diffuse`) or the lobe,
+/// weighed by the mixture; whether the path goes on.
+fn smooth_bounce(path: &mut Path, smooth: &Smooth, from: Vec3, diffuse: bool) -> bool {
+    let n = smooth.n;
+    let (w, cos) = if diffuse {
+        let (d, _) = cosine_direction(path, n);
+        let w = d.as_dvec3().normalize();
+        (w, w.dot(n.as_dvec3()))
+    } else {
+        let (u1, u2): (f64, f64) = (path.rng.random(), path.rng.random());
+        let Some((w, _)) = smooth.lobe.as_ref().and_then(|l| l.sample(u1, u2)) else {
+            return false;
+        };
+        (w, w.dot(n.as_dvec3()))
+    };
+    let pdf = smooth.pdf(w, cos);
+    if cos <= 0.0 || pdf <= 0.0 {
+        return false;
+    }
+    path.throughput = smooth.value(w, cos) / pdf;
+    if !roulette(path) {
+        return false;
+    }
+    path.bounce_pdf = pdf;
+    leave(path, from, w.as_vec3());
+    true
 }
 
 /// Russian roulette from the fourth bounce: keeps the path with probability q (its

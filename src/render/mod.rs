@@ -117,6 +117,50 @@ impl Default for RenderOptions {
 }
 
 impl RenderOptions {
+    /// Checks the render's settings: the first out of its range, as an
+    /// [`Error::Argument`](crate::Error::Argument) naming it.
+    pub fn validate(&self) -> Result<()> {
+        if let Direct::Traced { light_samples } = self.direct {
+            if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&light_samples) {
+                return Err(crate::Error::argument(
+                    "direct",
+                    format!(
+                        "{light_samples} shadow rays per area light: must lie in 1..={}",
+                        crate::light::MAX_LIGHT_SAMPLES
+                    ),
+                ));
+            }
+        }
+        if !(1..=MAX_GLOSSY_RAYS).contains(&self.glossy_rays) {
+            return Err(crate::Error::argument(
+                "glossy_rays",
+                format!(
+                    "{} rays per glossy bounce: must lie in 1..={MAX_GLOSSY_RAYS}",
+                    self.glossy_rays
+                ),
+            ));
+        }
+        if self.gather_rays > MAX_GATHER_RAYS {
+            return Err(crate::Error::argument(
+                "gather_rays",
+                format!(
+                    "{} gather rays per hit: must lie in 0..={MAX_GATHER_RAYS}",
+                    self.gather_rays
+                ),
+            ));
+        }
+        if !(1..=MAX_SUPERSAMPLE).contains(&self.supersample) {
+            return Err(crate::Error::argument(
+                "supersample",
+                format!(
+                    "{} rays per side of an edge pixel: must lie in 1..={MAX_SUPERSAMPLE}",
+                    self.supersample
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Fast and rough: fewer shadow rays at the hits, fewer rays on edges, no gather at
     /// contacts and creases ([`crate::Preset::Preview`]).
     pub fn preview() -> Self {
@@ -212,153 +256,132 @@ pub fn render_distributed(
         let camera = &scene.camera;
         camera.check()?;
         solution.check_fits(scene)?;
-        if let Direct::Traced { light_samples } = options.direct {
-            if !(1..=crate::light::MAX_LIGHT_SAMPLES).contains(&light_samples) {
-                return Err(crate::Error::argument(
-                    "direct",
-                    format!(
-                        "{light_samples} shadow rays per area light: must lie in 1..={}",
-                        crate::light::MAX_LIGHT_SAMPLES
-                    ),
-                ));
-            }
-        }
-        if !(1..=MAX_GLOSSY_RAYS).contains(&options.glossy_rays) {
-            return Err(crate::Error::argument(
-                "glossy_rays",
-                format!(
-                    "{} rays per glossy bounce: must lie in 1..={MAX_GLOSSY_RAYS}",
-                    options.glossy_rays
-                ),
-            ));
-        }
-        if options.gather_rays > MAX_GATHER_RAYS {
-            return Err(crate::Error::argument(
-                "gather_rays",
-                format!(
-                    "{} gather rays per hit: must lie in 0..={MAX_GATHER_RAYS}",
-                    options.gather_rays
-                ),
-            ));
-        }
-        if !(1..=MAX_SUPERSAMPLE).contains(&options.supersample) {
-            return Err(crate::Error::argument(
-                "supersample",
-                format!(
-                    "{} rays per side of an edge pixel: must lie in 1..={MAX_SUPERSAMPLE}",
-                    options.supersample
-                ),
-            ));
-        }
+        options.validate()?;
         crate::budget::check_image(
             options.memory_budget,
             (camera.width, camera.height),
             crate::budget::BYTES_PER_PIXEL,
         )?;
-        let (w, h) = (camera.width as usize, camera.height as usize);
         let shader = Shader::new(scene, &solution.field, vis, options);
-        let mut stats = RenderStats::default();
-        let mut reporter = Reporter::new(progress);
-        let base = Progress {
-            items: w * h,
-            ..Progress::of(Phase::Rendering)
-        };
-        reporter.report(base);
-
-        // Centre rays: radiance and the side each pixel sees.
-        let mut centre: Vec<(Vec3, u32)> = vec![(Vec3::ZERO, u32::MAX); w * h];
-        let queries = std::sync::atomic::AtomicU64::new(0);
-        let trace = |first: usize, out: &mut [(Vec3, u32)]| {
-            let rays: Vec<Ray> = (first..first + out.len())
-                .map(|p| camera_ray(scene, (p % w) as f32 + 0.5, (p / w) as f32 + 0.5))
-                .collect();
-            queries.fetch_add(
-                shader.shade(&rays, first as u32, out, 1)?,
-                std::sync::atomic::Ordering::Relaxed,
-            );
-            Ok(())
-        };
-        // Each rank a run of the rows (a Stop heard before leaves them all black).
-        // Every ray seeds its own shadow rays by its pixel: the stage needs no seed.
-        let exec = crate::exec::Exec::new(options.threads, 0, ranks);
-        let all = crate::distributed::for_share(
-            exec,
-            &mut centre,
-            w,
-            |first, out, _: &_| trace(first, out),
-            &mut |f| {
-                control(reporter.report(Progress {
-                    fraction: CENTRE_SHARE * f,
-                    ..base
-                }))
-            },
-            |c: &(Vec3, u32)| [c.0.x, c.0.y, c.0.z, c.1 as f32].map(f64::from),
-            |v| {
-                (
-                    Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32),
-                    v[3] as u32,
-                )
-            },
-        )? && !reporter.stopped();
-        stats.camera_rays = (w * h) as u64;
-
-        // Edge pixels, refined with more rays.
-        let edges = if all && options.supersample > 1 {
-            // In mirrors and on glossy surfaces an edge need not be one between sides: a
-            // light's highlight can be smaller than a pixel.
-            let contrast = shader.paths.is_some();
-            edge_pixels(&centre, w, h, options.supersample as usize, contrast)
-        } else {
-            Edges::default()
-        };
-        let mut refined = vec![None; edges.pixels.len()];
-        let refine = |first: usize, out: &mut [Option<Vec3>]| {
-            queries.fetch_add(
-                edges.shade(scene, &shader, first, out, w)?,
-                std::sync::atomic::Ordering::Relaxed,
-            );
-            Ok(())
-        };
-        // Each rank a run of the edge pixels (none after a Stop: `edges` is empty then).
-        let refined_all = crate::distributed::for_share(
-            exec,
-            &mut refined,
-            16,
-            |first, out, _: &_| refine(first, out),
-            &mut |f| {
-                control(reporter.report(Progress {
-                    fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,
-                    ..base
-                }))
-            },
-            |r: &Option<Vec3>| match r {
-                Some(v) => [1.0, f64::from(v.x), f64::from(v.y), f64::from(v.z)],
-                None => [0.0; 4],
-            },
-            |v| (v[0] != 0.0).then(|| Vec3::new(v[1] as f32, v[2] as f32, v[3] as f32)),
-        )?;
-        let all = all && refined_all;
-        stats.camera_rays += (edges.first_ray.last().copied().unwrap_or(w * h) - w * h) as u64;
-        stats.supersampled_pixels = refined.iter().filter(|r| r.is_some()).count() as u64;
-        stats.interpolation_queries = crate::distributed::sum_over(ranks, queries.into_inner())?;
-        stats.shadow_rays = crate::distributed::sum_over(ranks, shader.shadow_rays.into_inner())?;
-        stats.stopped = !all;
-
-        let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
-        for (&p, value) in edges.pixels.iter().zip(&refined) {
-            if let Some(value) = value {
-                pixels[p] = *value;
-            }
-        }
-        Ok((
-            Image {
-                width: camera.width,
-                height: camera.height,
-                pixels,
-            },
-            stats,
-        ))
+        draw(scene, &shader, options, ranks, progress)
     })
+}
+
+/// The image's passes: a centre ray per pixel (each rank a run of the rows), then the edge
+/// pixels with more rays (each rank a run of them); a Stop on any rank ends a pass.
+fn draw(
+    scene: &Scene,
+    shader: &Shader,
+    options: &RenderOptions,
+    ranks: &dyn crate::distributed::Ranks,
+    progress: Callback,
+) -> Result<(Image, RenderStats)> {
+    let camera = &scene.camera;
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let mut stats = RenderStats::default();
+    let mut reporter = Reporter::new(progress);
+    let base = Progress {
+        items: w * h,
+        ..Progress::of(Phase::Rendering)
+    };
+    reporter.report(base);
+
+    // Centre rays: radiance and the side each pixel sees.
+    let mut centre: Vec<(Vec3, u32)> = vec![(Vec3::ZERO, u32::MAX); w * h];
+    let queries = std::sync::atomic::AtomicU64::new(0);
+    let trace = |first: usize, out: &mut [(Vec3, u32)]| {
+        let rays: Vec<Ray> = (first..first + out.len())
+            .map(|p| camera_ray(scene, (p % w) as f32 + 0.5, (p / w) as f32 + 0.5))
+            .collect();
+        queries.fetch_add(
+            shader.shade(&rays, first as u32, out, 1)?,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+        Ok(())
+    };
+    // Each rank a run of the rows (a Stop heard before leaves them all black).
+    // Every ray seeds its own shadow rays by its pixel: the stage needs no seed.
+    let exec = crate::exec::Exec::new(options.threads, 0, ranks);
+    let all = crate::distributed::for_share(
+        exec,
+        &mut centre,
+        w,
+        |first, out, _: &_| trace(first, out),
+        &mut |f| {
+            control(reporter.report(Progress {
+                fraction: CENTRE_SHARE * f,
+                ..base
+            }))
+        },
+        |c: &(Vec3, u32)| [c.0.x, c.0.y, c.0.z, c.1 as f32].map(f64::from),
+        |v| {
+            (
+                Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32),
+                v[3] as u32,
+            )
+        },
+    )? && !reporter.stopped();
+    stats.camera_rays = (w * h) as u64;
+
+    // Edge pixels, refined with more rays.
+    let edges = if all && options.supersample > 1 {
+        // In mirrors and on glossy surfaces an edge need not be one between sides: a
+        // light's highlight can be smaller than a pixel.
+        let contrast = shader.paths.is_some();
+        edge_pixels(&centre, w, h, options.supersample as usize, contrast)
+    } else {
+        Edges::default()
+    };
+    let mut refined = vec![None; edges.pixels.len()];
+    let refine = |first: usize, out: &mut [Option<Vec3>]| {
+        queries.fetch_add(
+            edges.shade(scene, shader, first, out, w)?,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+        Ok(())
+    };
+    // Each rank a run of the edge pixels (none after a Stop: `edges` is empty then).
+    let refined_all = crate::distributed::for_share(
+        exec,
+        &mut refined,
+        16,
+        |first, out, _: &_| refine(first, out),
+        &mut |f| {
+            control(reporter.report(Progress {
+                fraction: CENTRE_SHARE + (1.0 - CENTRE_SHARE) * f,
+                ..base
+            }))
+        },
+        |r: &Option<Vec3>| match r {
+            Some(v) => [1.0, f64::from(v.x), f64::from(v.y), f64::from(v.z)],
+            None => [0.0; 4],
+        },
+        |v| (v[0] != 0.0).then(|| Vec3::new(v[1] as f32, v[2] as f32, v[3] as f32)),
+    )?;
+    let all = all && refined_all;
+    stats.camera_rays += (edges.first_ray.last().copied().unwrap_or(w * h) - w * h) as u64;
+    stats.supersampled_pixels = refined.iter().filter(|r| r.is_some()).count() as u64;
+    stats.interpolation_queries = crate::distributed::sum_over(ranks, queries.into_inner())?;
+    let shadow_rays = shader
+        .shadow_rays
+        .load(std::sync::atomic::Ordering::Relaxed);
+    stats.shadow_rays = crate::distributed::sum_over(ranks, shadow_rays)?;
+    stats.stopped = !all;
+
+    let mut pixels: Vec<Vec3> = centre.into_iter().map(|c| c.0).collect();
+    for (&p, value) in edges.pixels.iter().zip(&refined) {
+        if let Some(value) = value {
+            pixels[p] = *value;
+        }
+    }
+    Ok((
+        Image {
+            width: camera.width,
+            height: camera.height,
+            pixels,
+        },
+        stats,
+    ))
 }
 
 fn control(stop: bool) -> Control {

@@ -16,7 +16,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::poisson::side_seed;
-use super::{surface_of, Layout, Samples};
+use super::{surface_of, Layout, Samples, SideIndex};
 use crate::error::Result;
 use crate::exec::Exec;
 use crate::parallel::{for_chunks, Report};
@@ -143,51 +143,13 @@ pub(crate) fn refine(
         return Ok(Refinement::default());
     };
     let mut result = Refinement::default();
-    let eps = settings.epsilon;
-    let min_radius = eps / MAX_SPLIT;
-    let mut near = Vec::new();
     let old = samples.len();
-    // Discs to fill: (sample, old radius, count m).
-    let mut discs = Vec::new();
-    for (k, &e) in errors.iter().enumerate() {
-        // NaN (no neighbour) never refines.
-        let above = e > f64::from(settings.zeta);
-        if !above || samples.radius[k] <= min_radius {
-            continue;
-        }
-        near.clear();
-        index.within(
-            samples,
-            samples.side[k],
-            samples.uv[k],
-            2.0 * samples.radius[k],
-            &mut near,
-        );
-        let n = near.len().saturating_sub(1).max(1) as f64;
-        let old_radius = samples.radius[k];
-        // Darts for at most four times what the disc holds at the smallest radius: points at
-        // least r apart in a disc of radius R number at most (2R / r + 1)² (their r/2-discs
-        // are disjoint inside the disc grown by r/2). Past that, darts are only thrown away,
-        // and a tiny ζ would throw billions of them with no report between. (At once what it
-        // holds, the gallery lost 110 of 46,260 samples: more darts fill a disc more densely;
-        // at four times, every shipped scene places the same samples as without a cap.)
-        let holds = (2.0 * f64::from(old_radius / min_radius) + 1.0).powi(2);
-        let wanted = (n * (e / f64::from(settings.zeta) - 1.0)).floor().max(0.0) + 1.0;
-        let m = wanted.min(4.0 * holds);
-        samples.radius[k] = (old_radius / (m as f32 + 1.0).sqrt()).max(min_radius);
-        discs.push((k, old_radius, m as u32));
-        result.refined += 1;
-    }
+    let mut discs = discs_to_fill(samples, index, &errors, settings);
+    result.refined = discs.len();
     // The discs side by side (each side's in sample order), filled side by side in parallel:
     // a new sample is tested against the old samples and its own side's new ones only.
     discs.sort_by_key(|&(k, _, _)| (samples.side[k], k));
-    let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
-    for (i, &(k, _, _)) in discs.iter().enumerate() {
-        match groups.last_mut() {
-            Some(g) if samples.side[discs[g.start].0] == samples.side[k] => g.end = i + 1,
-            _ => groups.push(i..i + 1),
-        }
-    }
+    let groups = sides_of(&discs, samples);
     // Each side's discs in pieces of about PIECE_DARTS darts, every side's next piece at once,
     // with a report between: a tiny ζ throws millions of darts, and the host must hear from
     // the call and may stop it. A side's darts go in the same order whatever the pieces, so
@@ -198,19 +160,7 @@ pub(crate) fn refine(
     let mut thrown = 0u64;
     let shared: &Samples = samples;
     loop {
-        let pieces: Vec<std::ops::Range<usize>> = groups
-            .iter()
-            .zip(&next)
-            .map(|(g, &from)| {
-                let mut to = from;
-                let mut darts = 0;
-                while to < g.end && (to == from || darts < PIECE_DARTS) {
-                    darts += u64::from(discs[to].2) * DARTS;
-                    to += 1;
-                }
-                from..to
-            })
-            .collect();
+        let pieces = pieces_after(&groups, &next, &discs);
         if pieces.iter().all(|p| p.is_empty()) {
             break;
         }
@@ -272,6 +222,82 @@ pub(crate) fn refine(
         }
     }
     Ok(result)
+}
+
+/// The samples whose error exceeds ζ, as discs to fill with new samples: (sample, its old
+/// radius, how many new ones); their radii shrink to make room.
+fn discs_to_fill(
+    samples: &mut Samples,
+    index: &SideIndex,
+    errors: &[f64],
+    settings: RefineSettings,
+) -> Vec<(usize, f32, u32)> {
+    let min_radius = settings.epsilon / MAX_SPLIT;
+    let mut near = Vec::new();
+    let mut discs = Vec::new();
+    for (k, &e) in errors.iter().enumerate() {
+        // NaN (no neighbour) never refines.
+        let above = e > f64::from(settings.zeta);
+        if !above || samples.radius[k] <= min_radius {
+            continue;
+        }
+        near.clear();
+        index.within(
+            samples,
+            samples.side[k],
+            samples.uv[k],
+            2.0 * samples.radius[k],
+            &mut near,
+        );
+        let n = near.len().saturating_sub(1).max(1) as f64;
+        let old_radius = samples.radius[k];
+        // Darts for at most four times what the disc holds at the smallest radius: points at
+        // least r apart in a disc of radius R number at most (2R / r + 1)² (their r/2-discs
+        // are disjoint inside the disc grown by r/2). Past that, darts are only thrown away,
+        // and a tiny ζ would throw billions of them with no report between. (At once what it
+        // holds, the gallery lost 110 of 46,260 samples: more darts fill a disc more densely;
+        // at four times, every shipped scene places the same samples as without a cap.)
+        let holds = (2.0 * f64::from(old_radius / min_radius) + 1.0).powi(2);
+        let wanted = (n * (e / f64::from(settings.zeta) - 1.0)).floor().max(0.0) + 1.0;
+        let m = wanted.min(4.0 * holds);
+        samples.radius[k] = (old_radius / (m as f32 + 1.0).sqrt()).max(min_radius);
+        discs.push((k, old_radius, m as u32));
+    }
+    discs
+}
+
+/// The runs of `discs` (sorted by side) that lie on one side each.
+fn sides_of(discs: &[(usize, f32, u32)], samples: &Samples) -> Vec<std::ops::Range<usize>> {
+    let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
+    for (i, &(k, _, _)) in discs.iter().enumerate() {
+        match groups.last_mut() {
+            Some(g) if samples.side[discs[g.start].0] == samples.side[k] => g.end = i + 1,
+            _ => groups.push(i..i + 1),
+        }
+    }
+    groups
+}
+
+/// Each side's next piece of discs, from `next`: about PIECE_DARTS darts (a disc is never
+/// split).
+fn pieces_after(
+    groups: &[std::ops::Range<usize>],
+    next: &[usize],
+    discs: &[(usize, f32, u32)],
+) -> Vec<std::ops::Range<usize>> {
+    groups
+        .iter()
+        .zip(next)
+        .map(|(g, &from)| {
+            let mut to = from;
+            let mut darts = 0;
+            while to < g.end && (to == from || darts < PIECE_DARTS) {
+                darts += u64::from(discs[to].2) * DARTS;
+                to += 1;
+            }
+            from..to
+        })
+        .collect()
 }
 
 /// Eq. 8's Poisson-disk darts in the discs of one side, in order: the new points with their

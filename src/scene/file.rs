@@ -660,25 +660,7 @@ fn daylight(
     let site_fail = |problem: String| site_fail(problem, &sky_span);
     let s = site.cloned().unwrap_or_default();
     let sun_needed = !matches!(k.model.as_str(), "cie-overcast" | "uniform");
-    let model = match (k.model.as_str(), k.kind) {
-        ("cie-overcast", None) => SkyModel::CieOvercast,
-        ("uniform", None) => SkyModel::Uniform,
-        ("cie", Some(t)) if (1..=15).contains(&t) => SkyModel::Cie(t),
-        ("cie", Some(t)) => return Err(fail(format!("type = {t}: the general skies are 1 to 15"))),
-        ("cie", None) => return Err(fail("model = \"cie\" needs type = 1 to 15".into())),
-        ("perez", None) => SkyModel::Perez {
-            clearness: 1.0,
-            brightness: 0.2,
-        },
-        (m @ ("cie-overcast" | "uniform" | "perez"), Some(_)) => {
-            return Err(fail(format!("type is for model = \"cie\", not \"{m}\"")))
-        }
-        (other, _) => {
-            return Err(fail(format!(
-                "model = \"{other}\": one of \"cie-overcast\", \"uniform\", \"cie\", \"perez\""
-            )))
-        }
-    };
+    let model = sky_model(&k.model, k.kind).map_err(&fail)?;
     let diffuse = match k.diffuse_horizontal {
         Some(e) if e.is_finite() && e >= 0.0 => e,
         Some(e) => {
@@ -704,7 +686,79 @@ fn daylight(
         None => 0.0,
     };
     // The sun: from the time at the site, or given.
-    let (sun, day) = match (k.time.as_deref(), k.sun_altitude, k.sun_azimuth) {
+    let (sun, day) = sun_of(&k, &s, &fail, &site_fail)?;
+    if sun.is_none() && (sun_needed || direct > 0.0) {
+        return Err(fail(format!(
+            "model = \"{}\"{} needs the sun's position: a time (with the site's latitude, \
+             longitude and timezone) or sun_altitude and sun_azimuth",
+            k.model,
+            if direct > 0.0 {
+                " with direct_normal"
+            } else {
+                ""
+            }
+        )));
+    }
+    let (zenith, azimuth) = sun.unwrap_or((0.0, 0.0));
+    let model = match model {
+        SkyModel::Perez { .. } => {
+            let (clearness, brightness) =
+                crate::daylight::sky::perez_parameters(diffuse, direct, zenith.min(90.0), day);
+            SkyModel::Perez {
+                clearness,
+                brightness,
+            }
+        }
+        m => m,
+    };
+    let sky = Sky::new(model, zenith, azimuth, diffuse).map_err(|e| fail(e.to_string()))?;
+    Daylight::new(
+        sky,
+        s.up,
+        s.north,
+        s.ground_reflectance,
+        diffuse,
+        sun,
+        direct,
+    )
+    .map_err(|e| site_fail(e.to_string()))
+}
+
+/// `model` (and `type`) of `[sky]`; a Perez sky's parameters come later, from the light.
+fn sky_model(model: &str, kind: Option<u8>) -> std::result::Result<SkyModel, String> {
+    Ok(match (model, kind) {
+        ("cie-overcast", None) => SkyModel::CieOvercast,
+        ("uniform", None) => SkyModel::Uniform,
+        ("cie", Some(t)) if (1..=15).contains(&t) => SkyModel::Cie(t),
+        ("cie", Some(t)) => return Err(format!("type = {t}: the general skies are 1 to 15")),
+        ("cie", None) => return Err("model = \"cie\" needs type = 1 to 15".into()),
+        ("perez", None) => SkyModel::Perez {
+            clearness: 1.0,
+            brightness: 0.2,
+        },
+        (m @ ("cie-overcast" | "uniform" | "perez"), Some(_)) => {
+            return Err(format!("type is for model = \"cie\", not \"{m}\""))
+        }
+        (other, _) => {
+            return Err(format!(
+                "model = \"{other}\": one of \"cie-overcast\", \"uniform\", \"cie\", \"perez\""
+            ))
+        }
+    })
+}
+
+/// A direction in the sky: zenith angle and azimuth, degrees.
+type ZenithAzimuth = (f64, f64);
+
+/// The sun's (zenith, azimuth) and the day of the year: from `[sky]`'s time at the site, or its
+/// given altitude and azimuth, or none.
+fn sun_of(
+    k: &SkyToml,
+    s: &Site,
+    fail: &dyn Fn(String) -> Error,
+    site_fail: &dyn Fn(String) -> Error,
+) -> Result<(Option<ZenithAzimuth>, Option<u32>)> {
+    Ok(match (k.time.as_deref(), k.sun_altitude, k.sun_azimuth) {
         (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
             return Err(fail(
                 "give the time or sun_altitude and sun_azimuth, not both".into(),
@@ -747,42 +801,7 @@ fn daylight(
             return Err(fail("give both sun_altitude and sun_azimuth".into()))
         }
         (None, None, None) => (None, None),
-    };
-    if sun.is_none() && (sun_needed || direct > 0.0) {
-        return Err(fail(format!(
-            "model = \"{}\"{} needs the sun's position: a time (with the site's latitude, \
-             longitude and timezone) or sun_altitude and sun_azimuth",
-            k.model,
-            if direct > 0.0 {
-                " with direct_normal"
-            } else {
-                ""
-            }
-        )));
-    }
-    let (zenith, azimuth) = sun.unwrap_or((0.0, 0.0));
-    let model = match model {
-        SkyModel::Perez { .. } => {
-            let (clearness, brightness) =
-                crate::daylight::sky::perez_parameters(diffuse, direct, zenith.min(90.0), day);
-            SkyModel::Perez {
-                clearness,
-                brightness,
-            }
-        }
-        m => m,
-    };
-    let sky = Sky::new(model, zenith, azimuth, diffuse).map_err(|e| fail(e.to_string()))?;
-    Daylight::new(
-        sky,
-        s.up,
-        s.north,
-        s.ground_reflectance,
-        diffuse,
-        sun,
-        direct,
-    )
-    .map_err(|e| site_fail(e.to_string()))
+    })
 }
 
 #[cfg(test)]

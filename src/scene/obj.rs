@@ -35,13 +35,65 @@ pub(super) fn read(
 ) -> Result<(Mesh, Vec<String>)> {
     let text = read_text(files, path)?;
     let prepared = prepare_obj(path, &text)?;
-    let dir = path.parent().unwrap_or(Path::new(""));
 
+    let Loaded {
+        models,
+        materials: tobj_materials,
+        libraries,
+        missing,
+    } = load(files, path, &prepared)?;
+    let mut warnings = missing;
+    let any_missing = !warnings.is_empty();
+    for library in &libraries {
+        warnings.extend(library.warnings.iter().cloned());
+    }
+    let (mut materials, transforms) =
+        materials_from(files, &tobj_materials, &libraries, rules, &mut warnings)?;
+    // A material a missing MTL file may have defined gets the default grey (below).
+    let before = warnings.len();
+    if !any_missing {
+        check_usemtl(
+            path,
+            &prepared.usemtl,
+            &materials,
+            &libraries,
+            &mut warnings,
+        );
+    }
+
+    let (mut mesh, unassigned) = triangles(&models, &mut materials);
+    // Faces under a usemtl that names nothing, or from a missing MTL, were spoken for above.
+    let said = any_missing || warnings.len() > before;
+    mesh.materials = materials;
+    mesh.texcoords = texcoords(path, &prepared, &mesh, &transforms, &mut warnings);
+    if unassigned > 0 && !said {
+        warnings.push(format!(
+            "{}: {unassigned} triangle{} have no material: they get Kd = {DEFAULT_KD} grey",
+            path.display(),
+            if unassigned == 1 { "" } else { "s" }
+        ));
+    }
+    if prepared.short_faces > 0 {
+        warnings.push(format!(
+            "{}: ignored {} face{} with fewer than 3 vertices",
+            path.display(),
+            prepared.short_faces,
+            if prepared.short_faces == 1 { "" } else { "s" }
+        ));
+    }
+    Ok((mesh, warnings))
+}
+
+/// What tobj reads of the prepared OBJ and the MTL files it names: the models, the materials,
+/// the MTL files as read (with their lines), and a warning for each MTL file not found (its
+/// materials' faces get the default grey). tobj hands over the rest of an `mtllib` line as one
+/// name: several files are allowed there (separated by spaces), each read and their materials
+/// merged in order.
+fn load(files: &dyn super::Source, path: &Path, prepared: &PreparedObj) -> Result<Loaded> {
+    let dir = path.parent().unwrap_or(Path::new(""));
     let libraries: RefCell<Vec<MtlLibrary>> = RefCell::new(Vec::new());
     let failure: RefCell<Option<Error>> = RefCell::new(None);
     let missing: RefCell<Vec<String>> = RefCell::new(Vec::new());
-    // tobj hands over the rest of an `mtllib` line as one name: several files are allowed
-    // there (separated by spaces), each read and their materials merged in order.
     let loader = |names: &Path| -> tobj::MTLLoadResult {
         let mut merged: (Vec<tobj::Material>, HashMap<String, usize>) = Default::default();
         let names = names.to_string_lossy();
@@ -92,29 +144,30 @@ pub(super) fn read(
     let tobj_materials = tobj_materials.unwrap_or_default();
     let libraries = libraries.into_inner();
 
-    let mut warnings = missing.into_inner();
-    let any_missing = !warnings.is_empty();
-    for library in &libraries {
-        warnings.extend(library.warnings.iter().cloned());
-    }
-    let (mut materials, transforms) =
-        materials_from(files, &tobj_materials, &libraries, rules, &mut warnings)?;
-    // A material a missing MTL file may have defined gets the default grey (below).
-    let before = warnings.len();
-    if !any_missing {
-        check_usemtl(
-            path,
-            &prepared.usemtl,
-            &materials,
-            &libraries,
-            &mut warnings,
-        );
-    }
+    Ok(Loaded {
+        models,
+        materials: tobj_materials,
+        libraries,
+        missing: missing.into_inner(),
+    })
+}
 
+/// What [`load`] read.
+struct Loaded {
+    models: Vec<tobj::Model>,
+    materials: Vec<tobj::Material>,
+    libraries: Vec<MtlLibrary>,
+    /// A warning for each MTL file not found.
+    missing: Vec<String>,
+}
+
+/// The models' triangles with their materials; faces without one get the default grey
+/// material, added once. The number of such triangles.
+fn triangles(models: &[tobj::Model], materials: &mut Vec<Material>) -> (Mesh, usize) {
     let mut mesh = Mesh::default();
     let mut default_material: Option<u32> = None;
     let mut unassigned = 0usize;
-    for model in &models {
+    for model in models {
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
         mesh.positions.extend(
@@ -141,26 +194,7 @@ pub(super) fn read(
             mesh.triangle_materials.push(material);
         }
     }
-    // Faces under a usemtl that names nothing, or from a missing MTL, were spoken for above.
-    let said = any_missing || warnings.len() > before;
-    mesh.materials = materials;
-    mesh.texcoords = texcoords(path, &prepared, &mesh, &transforms, &mut warnings);
-    if unassigned > 0 && !said {
-        warnings.push(format!(
-            "{}: {unassigned} triangle{} have no material: they get Kd = {DEFAULT_KD} grey",
-            path.display(),
-            if unassigned == 1 { "" } else { "s" }
-        ));
-    }
-    if prepared.short_faces > 0 {
-        warnings.push(format!(
-            "{}: ignored {} face{} with fewer than 3 vertices",
-            path.display(),
-            prepared.short_faces,
-            if prepared.short_faces == 1 { "" } else { "s" }
-        ));
-    }
-    Ok((mesh, warnings))
+    (mesh, unassigned)
 }
 
 /// Each triangle's image coordinates where its material has a texture and all its corners

@@ -370,25 +370,9 @@ pub fn solve_distributed(
     })
 }
 
-/// Which shooting solver a solve runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Method {
-    /// Every sample linked to every sample (`flat`).
-    Flat,
-    /// The cluster hierarchy (`cluster`), at the options' threshold, even 0.
-    Hierarchy,
-}
-
-fn solve_with(
-    scene: &Scene,
-    vis: &dyn Visibility,
-    options: &Options,
-    ranks: &dyn crate::distributed::Ranks,
-    progress: crate::progress::Callback,
-    method: Method,
-) -> Result<Solution> {
-    options.validate()?;
-    let (epsilon, epsilon_source) = choose_epsilon(scene, options)?;
+/// Refuses an ε that would place more samples than `options.max_samples`, or samples that
+/// would take more than half the memory budget, before anything is allocated.
+fn refuse_too_many(scene: &Scene, options: &Options, epsilon: f32) -> Result<()> {
     let predicted = predicted_samples(scene, epsilon);
     if predicted > options.max_samples as f64 {
         return Err(Error::Option {
@@ -416,6 +400,29 @@ fn solve_with(
             ),
         ));
     }
+    Ok(())
+}
+
+/// Which shooting solver a solve runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Method {
+    /// Every sample linked to every sample (`flat`).
+    Flat,
+    /// The cluster hierarchy (`cluster`), at the options' threshold, even 0.
+    Hierarchy,
+}
+
+fn solve_with(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &Options,
+    ranks: &dyn crate::distributed::Ranks,
+    progress: crate::progress::Callback,
+    method: Method,
+) -> Result<Solution> {
+    options.validate()?;
+    let (epsilon, epsilon_source) = choose_epsilon(scene, options)?;
+    refuse_too_many(scene, options, epsilon)?;
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
     let obstruction = Obstruction::new(scene, &maps, lift);

@@ -291,8 +291,6 @@ impl<'a> Solve<'a> {
         round: u32,
         first_new: usize,
     ) -> Result<u64> {
-        let (scene, vis, options) = (self.scene, self.vis, self.options);
-        let threads = options.threads.max(1);
         let n = solution.field.samples.len();
         self.begin(Phase::DirectLight, round, n);
         let s = &solution.field.samples;
@@ -300,21 +298,8 @@ impl<'a> Solve<'a> {
             .map(|k| (s.position[k], s.normal[k]))
             .collect();
         let ids: Vec<u32> = (first_new as u32..n as u32).collect();
-        let (mut arrivals, mut queries, covered) = if self.reporter.stopped() {
-            (
-                vec![Arrival::default(); points.len()],
-                0,
-                vec![false; points.len()],
-            )
-        } else {
-            let base = self.base(Phase::DirectLight, round, n);
-            let at = (points.as_slice(), ids.as_slice());
-            let exec = self.exec();
-            let mut report = self.reporter.part(base);
-            let (arrivals, queries) = arrive(&self.light, vis, exec, at, &mut report)?;
-            let covered = cover::covered(vis, &points, self.lift, self.epsilon, threads)?;
-            (arrivals, queries, covered)
-        };
+        let at = (points.as_slice(), ids.as_slice());
+        let (mut arrivals, mut queries, covered) = self.lights_and_cover(round, n, at)?;
         if first_new == 0 {
             self.light_scale = self.balance(solution, &arrivals)?;
         }
@@ -322,55 +307,82 @@ impl<'a> Solve<'a> {
             a.irradiance *= self.light_scale;
         }
         solution.field.layout.cover(&covered);
-        let at = (points.as_slice(), ids.as_slice());
         queries += self.specular_light(solution, round, first_new, at)?;
         queries += self.daylight(solution, round, at)?;
+        let (scene, vis, alpha) = (self.scene, self.vis, self.options.alpha);
         warm::start(
             scene,
             solution,
             vis,
             first_new,
             &arrivals,
-            options.alpha,
+            alpha,
             self.exec(),
         )?;
-        if round == 0 && !solution.field.daylight.is_empty() {
-            // Daylight is a source too: what enters is what the shooting measures against (the
-            // sky's and the ground's, and the sun's, which the samples' direct light holds
-            // mixed with the lamps': measured on its own here).
+        if round == 0 {
+            queries += self.book_first_light(solution)?;
+        }
+        Ok(queries)
+    }
+
+    /// The lights' direct light at the new samples `at` (of `n` in all) and whether something
+    /// covers each; nothing (and no queries) once the host has stopped the solve.
+    fn lights_and_cover(
+        &mut self,
+        round: u32,
+        n: usize,
+        at: (&[(Vec3, Vec3)], &[u32]),
+    ) -> Result<(Vec<Arrival>, u64, Vec<bool>)> {
+        let count = at.0.len();
+        if self.reporter.stopped() {
+            return Ok((vec![Arrival::default(); count], 0, vec![false; count]));
+        }
+        let base = self.base(Phase::DirectLight, round, n);
+        let exec = self.exec();
+        let mut report = self.reporter.part(base);
+        let (arrivals, queries) = arrive(&self.light, self.vis, exec, at, &mut report)?;
+        let covered = cover::covered(self.vis, at.0, self.lift, self.epsilon, exec.threads)?;
+        Ok((arrivals, queries, covered))
+    }
+
+    /// The first round's energy account: daylight entering is a source too (what the shooting
+    /// measures against: the sky's and the ground's, and the sun's, which the samples' direct
+    /// light holds mixed with the lamps', measured on its own here), and direct light that
+    /// reached no sample's area left the scene. The queries the sun's share took.
+    fn book_first_light(&mut self, solution: &mut Solution) -> Result<u64> {
+        let n = solution.field.samples.len();
+        let mut queries = 0;
+        if !solution.field.daylight.is_empty() {
             let mut entering: DVec3 = (0..n)
                 .map(|k| solution.field.daylight[k] * solution.field.samples.area[k])
                 .sum();
-            if let Some(sun) = DirectLight::sun_only(scene, options.light_samples) {
-                if !self.reporter.stopped() {
-                    let s = &solution.field.samples;
-                    let points: Vec<(Vec3, Vec3)> =
-                        (0..n).map(|k| (s.position[k], s.normal[k])).collect();
-                    let ids: Vec<u32> = (0..n as u32).collect();
-                    let mut quiet = |_: f64| crate::progress::Control::Continue;
-                    let (arrivals, q) =
-                        sun.at(vis, &points, &ids, options.seed, threads, &mut quiet)?;
-                    queries += q;
-                    entering += arrivals
-                        .iter()
-                        .zip(&s.area)
-                        .map(|(a, &area)| a.irradiance * area)
-                        .sum::<DVec3>();
-                }
+            let sun = DirectLight::sun_only(self.scene, self.options.light_samples);
+            if let Some(sun) = sun.filter(|_| !self.reporter.stopped()) {
+                let s = &solution.field.samples;
+                let points: Vec<(Vec3, Vec3)> =
+                    (0..n).map(|k| (s.position[k], s.normal[k])).collect();
+                let ids: Vec<u32> = (0..n as u32).collect();
+                let mut quiet = |_: f64| crate::progress::Control::Continue;
+                let exec = self.exec();
+                let (arrivals, q) =
+                    sun.at(self.vis, &points, &ids, exec.seed, exec.threads, &mut quiet)?;
+                queries += q;
+                entering += arrivals
+                    .iter()
+                    .zip(&s.area)
+                    .map(|(a, &area)| a.irradiance * area)
+                    .sum::<DVec3>();
             }
             solution.ledger.emitted += entering;
         }
-        if round == 0 {
-            // Direct light that reached no sample area left the scene.
-            let received: DVec3 = (0..n)
-                .map(|k| {
-                    let exact = solution.field.direct[k].irradiance
-                        + warm::exact_beyond_direct(solution, k);
-                    exact * solution.field.samples.area[k]
-                })
-                .sum();
-            solution.ledger.escaped += solution.ledger.emitted - received;
-        }
+        let received: DVec3 = (0..n)
+            .map(|k| {
+                let exact =
+                    solution.field.direct[k].irradiance + warm::exact_beyond_direct(solution, k);
+                exact * solution.field.samples.area[k]
+            })
+            .sum();
+        solution.ledger.escaped += solution.ledger.emitted - received;
         Ok(queries)
     }
 

@@ -176,48 +176,7 @@ impl Chains<'_> {
         let m = highlight_samples(self.rays);
         let k = f64::from(self.rays.max(1));
         let pi = std::f64::consts::PI;
-        let mut drawn: Vec<Drawn> = Vec::new();
-        for (r, &(x, n, id)) in receivers.iter().enumerate() {
-            let from = x + self.lift * n;
-            let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 41));
-            for (p, plane) in self.highlights.planes.iter().enumerate() {
-                if !plane.faces(x) {
-                    continue;
-                }
-                let areas = self
-                    .lights
-                    .area_lights()
-                    .map(|(i, ..)| Err::<usize, usize>(i));
-                let points = (0..self.lights.point_sources().len()).map(Ok);
-                for light in areas.chain(points) {
-                    for _ in 0..m {
-                        let (l, normal) = match light {
-                            Err(i) => self.lights.point_on(i, rng.random(), rng.random()),
-                            Ok(j) => (self.lights.point_sources()[j].position, Vec3::ZERO),
-                        };
-                        let (u1, u2) = (rng.random(), rng.random());
-                        let Some(omega) = plane.draw(from, l, u1, u2) else {
-                            continue;
-                        };
-                        if f64::from(n.dot(omega.as_vec3())) <= 0.0 || !plane.faces(l) {
-                            continue;
-                        }
-                        drawn.push((
-                            r as u32,
-                            p,
-                            light,
-                            (l, normal),
-                            Ray {
-                                origin: from,
-                                dir: omega.as_vec3(),
-                                t_min: 0.0,
-                                t_max: f32::INFINITY,
-                            },
-                        ));
-                    }
-                }
-            }
-        }
+        let drawn = self.draw_highlights(receivers, seed);
         let rays: Vec<Ray> = drawn.iter().map(|d| d.4).collect();
         let mut hits = vec![None; rays.len()];
         self.vis.intersect(&rays, &mut hits)?;
@@ -286,6 +245,55 @@ impl Chains<'_> {
             }
         }
         Ok(rays.len() as u64)
+    }
+
+    /// For each receiver, glossy plane it faces and light: `highlight_samples` directions
+    /// towards the plane drawn where the light's mirror image would be seen in it.
+    fn draw_highlights(&self, receivers: &[(Vec3, Vec3, u32)], seed: u64) -> Vec<Drawn> {
+        let m = highlight_samples(self.rays);
+        let mut drawn: Vec<Drawn> = Vec::new();
+        for (r, &(x, n, id)) in receivers.iter().enumerate() {
+            let from = x + self.lift * n;
+            let mut rng = Pcg64Mcg::seed_from_u64(side_seed(seed, id, 41));
+            for (p, plane) in self.highlights.planes.iter().enumerate() {
+                if !plane.faces(x) {
+                    continue;
+                }
+                let areas = self
+                    .lights
+                    .area_lights()
+                    .map(|(i, ..)| Err::<usize, usize>(i));
+                let points = (0..self.lights.point_sources().len()).map(Ok);
+                for light in areas.chain(points) {
+                    for _ in 0..m {
+                        let (l, normal) = match light {
+                            Err(i) => self.lights.point_on(i, rng.random(), rng.random()),
+                            Ok(j) => (self.lights.point_sources()[j].position, Vec3::ZERO),
+                        };
+                        let (u1, u2) = (rng.random(), rng.random());
+                        let Some(omega) = plane.draw(from, l, u1, u2) else {
+                            continue;
+                        };
+                        if f64::from(n.dot(omega.as_vec3())) <= 0.0 || !plane.faces(l) {
+                            continue;
+                        }
+                        drawn.push((
+                            r as u32,
+                            p,
+                            light,
+                            (l, normal),
+                            Ray {
+                                origin: from,
+                                dir: omega.as_vec3(),
+                                t_min: 0.0,
+                                t_max: f32::INFINITY,
+                            },
+                        ));
+                    }
+                }
+            }
+        }
+        drawn
     }
 
     /// Follows `rays` chains from each receiver (point, normal, id: the seed of its random

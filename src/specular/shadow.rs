@@ -113,7 +113,7 @@ pub(crate) fn arriving(
             let dir = ray.dir.normalize();
             let cos = f64::from(dir.dot(normal));
             let point = ray.origin + hit.t * ray.dir;
-            match window {
+            let goes_on = match window {
                 Some(r) if r.surface == surface && (cos < 0.0 || r.both_sides) => {
                     w.share *= r.reflects.at(cos.abs());
                     let side = if cos < 0.0 { normal } else { -normal };
@@ -121,39 +121,14 @@ pub(crate) fn arriving(
                     w.target = reflect_point(r, w.target);
                     w.stage += 1;
                     w.entered = None;
+                    true
                 }
-                _ => match spec.glass[surface as usize] {
-                    Some((ior, filter, thin))
-                        if spec.straight[surface as usize] && w.crossings < MAX_CROSSINGS =>
-                    {
-                        let ior = f64::from(ior);
-                        let filter = filter.as_dvec3();
-                        let passed = if thin {
-                            1.0 - fresnel::pane_reflectance(cos.abs(), ior)
-                        } else if cos < 0.0 {
-                            let r = fresnel::reflectance(-cos, ior);
-                            w.entered = Some(r);
-                            1.0 - r
-                        } else {
-                            // Leaving, at the angle the straight line has in air on this side:
-                            // refracted, light leaves at the angle it entered at, so the Fresnel
-                            // factor is taken from outside (no total internal reflection that a
-                            // bent ray would not have).
-                            let r = fresnel::reflectance(cos, ior);
-                            let bounces =
-                                w.entered.take().map_or(1.0, |r_in| 1.0 / (1.0 - r_in * r));
-                            (1.0 - r) * bounces
-                        };
-                        w.share *= filter * passed;
-                        w.origin = point + lift * dir;
-                        w.crossings += 1;
-                    }
-                    _ => {
-                        w.share = DVec3::ZERO;
-                        w.done = true;
-                        continue;
-                    }
-                },
+                _ => cross(spec, surface, w, point, dir, cos, lift),
+            };
+            if !goes_on {
+                w.share = DVec3::ZERO;
+                w.done = true;
+                continue;
             }
             if w.share.max_element() > 0.0 {
                 still.push(i);
@@ -167,4 +142,44 @@ pub(crate) fn arriving(
         *o = w.share;
     }
     Ok(queries)
+}
+
+/// A walk meets `surface` at `point` (along `dir`, at cosine `cos` with its normal) other
+/// than at its next window: glass it may cross straight (its share dimmed by the faces'
+/// transmission, a solid's inner bounces summed); anything else stops the light (false).
+fn cross(
+    spec: &Specular,
+    surface: u32,
+    w: &mut Walk,
+    point: Vec3,
+    dir: Vec3,
+    cos: f64,
+    lift: f32,
+) -> bool {
+    let Some((ior, filter, thin)) = spec.glass[surface as usize] else {
+        return false;
+    };
+    if !(spec.straight[surface as usize] && w.crossings < MAX_CROSSINGS) {
+        return false;
+    }
+    let ior = f64::from(ior);
+    let filter = filter.as_dvec3();
+    let passed = if thin {
+        1.0 - fresnel::pane_reflectance(cos.abs(), ior)
+    } else if cos < 0.0 {
+        let r = fresnel::reflectance(-cos, ior);
+        w.entered = Some(r);
+        1.0 - r
+    } else {
+        // Leaving, at the angle the straight line has in air on this side: refracted, light
+        // leaves at the angle it entered at, so the Fresnel factor is taken from outside (no
+        // total internal reflection that a bent ray would not have).
+        let r = fresnel::reflectance(cos, ior);
+        let bounces = w.entered.take().map_or(1.0, |r_in| 1.0 / (1.0 - r_in * r));
+        (1.0 - r) * bounces
+    };
+    w.share *= filter * passed;
+    w.origin = point + lift * dir;
+    w.crossings += 1;
+    true
 }

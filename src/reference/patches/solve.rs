@@ -171,49 +171,15 @@ pub(crate) fn shoot(
                 break;
             }
         }
-        let shooter = patches[best];
         let unshot = std::mem::take(&mut state[best].unshot);
-        let from = shooter.centre + lift * shooter.normal;
         let cast = std::sync::atomic::AtomicU64::new(0);
         let workers = threads.min(n / PARALLEL_SHOT).max(1);
         for_chunks(&mut state, n.div_ceil(workers), workers, |first, out| {
-            let mut targets: Vec<(usize, f64)> = Vec::new();
-            let mut unknown: Vec<usize> = Vec::new();
-            let mut segments: Vec<Segment> = Vec::new();
-            for k in 0..out.len() {
-                let j = first + k;
-                let r = &patches[j];
-                if j == best || r.surface == shooter.surface || r.kd.max_element() <= 0.0 {
-                    continue;
-                }
-                let d = r.centre - shooter.centre;
-                let r2 = f64::from(d.length_squared());
-                if r2 <= 0.0 {
-                    continue;
-                }
-                let dir = d / r2.sqrt() as f32;
-                let (cos_s, cos_r) = (
-                    f64::from(shooter.normal.dot(dir)),
-                    f64::from(-r.normal.dot(dir)),
-                );
-                if cos_s <= 0.0 || cos_r <= 0.0 {
-                    continue;
-                }
-                // The form factor from the receiver's centre to a disc of the shooter's area.
-                let f = shooter.area * cos_s * cos_r / (std::f64::consts::PI * r2 + shooter.area);
-                match memo.as_ref().and_then(|m| m.get(best, j)) {
-                    Some(true) => targets.push((k, f)),
-                    Some(false) => {}
-                    None => {
-                        unknown.push(targets.len());
-                        targets.push((k, f));
-                        segments.push(Segment {
-                            a: from,
-                            b: r.centre + lift * r.normal,
-                        });
-                    }
-                }
-            }
+            let Receivers {
+                mut targets,
+                unknown,
+                segments,
+            } = receivers(patches, best, first..first + out.len(), memo.as_ref(), lift);
             let mut blocked = vec![false; segments.len()];
             vis.occluded(&segments, &mut blocked)?;
             cast.fetch_add(segments.len() as u64, Ordering::Relaxed);
@@ -252,4 +218,66 @@ pub(crate) fn shoot(
         unshot_fraction: fraction,
         stopped,
     })
+}
+
+/// The patches of `range` that patch `best` shoots to: (index in the range, form factor from
+/// the receiver's centre to a disc of the shooter's area); which of them still need a
+/// visibility query (the memo does not know them), and those queries' segments.
+fn receivers(
+    patches: &[Patch],
+    best: usize,
+    range: std::ops::Range<usize>,
+    memo: Option<&Memo>,
+    lift: f32,
+) -> Receivers {
+    let shooter = patches[best];
+    let from = shooter.centre + lift * shooter.normal;
+    let mut targets: Vec<(usize, f64)> = Vec::new();
+    let mut unknown: Vec<usize> = Vec::new();
+    let mut segments: Vec<Segment> = Vec::new();
+    for (k, j) in range.enumerate() {
+        let r = &patches[j];
+        if j == best || r.surface == shooter.surface || r.kd.max_element() <= 0.0 {
+            continue;
+        }
+        let d = r.centre - shooter.centre;
+        let r2 = f64::from(d.length_squared());
+        if r2 <= 0.0 {
+            continue;
+        }
+        let dir = d / r2.sqrt() as f32;
+        let (cos_s, cos_r) = (
+            f64::from(shooter.normal.dot(dir)),
+            f64::from(-r.normal.dot(dir)),
+        );
+        if cos_s <= 0.0 || cos_r <= 0.0 {
+            continue;
+        }
+        // The form factor from the receiver's centre to a disc of the shooter's area.
+        let f = shooter.area * cos_s * cos_r / (std::f64::consts::PI * r2 + shooter.area);
+        match memo.as_ref().and_then(|m| m.get(best, j)) {
+            Some(true) => targets.push((k, f)),
+            Some(false) => {}
+            None => {
+                unknown.push(targets.len());
+                targets.push((k, f));
+                segments.push(Segment {
+                    a: from,
+                    b: r.centre + lift * r.normal,
+                });
+            }
+        }
+    }
+    Receivers {
+        targets,
+        unknown,
+        segments,
+    }
+}
+
+/// What [`receivers`] finds.
+struct Receivers {
+    targets: Vec<(usize, f64)>,
+    unknown: Vec<usize>,
+    segments: Vec<Segment>,
 }

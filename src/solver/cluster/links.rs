@@ -519,31 +519,7 @@ impl Linker<'_> {
             return;
         }
         if a.is_leaf() && b.is_leaf() {
-            let (i, k) = (a.index(), b.index());
-            let ab = (dirs & INTO_B != 0)
-                .then(|| Shooter::of(self.samples, self.maps, i).factor_to(self.samples, k))
-                .flatten();
-            let ba = (dirs & INTO_A != 0)
-                .then(|| Shooter::of(self.samples, self.maps, k).factor_to(self.samples, i))
-                .flatten();
-            if ab.is_some() || ba.is_some() {
-                pending.push(Pending {
-                    a,
-                    b,
-                    dirs,
-                    first: probes.len(),
-                    probes: 1,
-                    kind: Kind::Leaf(ab, ba),
-                });
-                probes.push(Probe {
-                    i: i as u32,
-                    k: k as u32,
-                    exact: [0.0; 2],
-                    formula: [0.0; 2],
-                    ray: Some(segments.len() as u32),
-                });
-                segments.push(segment(self.samples, self.lift, i, k));
-            }
+            self.leaf_pair(pair, pending, segments, probes);
             return;
         }
         let d = bv.centroid - av.centroid;
@@ -606,6 +582,42 @@ impl Linker<'_> {
             }
         }
         self.split(pair, stack);
+    }
+
+    /// Two samples: the form factor each way the pair carries light, and its probe ray.
+    fn leaf_pair(
+        &self,
+        pair: Pair,
+        pending: &mut Vec<Pending>,
+        segments: &mut Vec<Segment>,
+        probes: &mut Vec<Probe>,
+    ) {
+        let Pair { a, b, dirs } = pair;
+        let (i, k) = (a.index(), b.index());
+        let ab = (dirs & INTO_B != 0)
+            .then(|| Shooter::of(self.samples, self.maps, i).factor_to(self.samples, k))
+            .flatten();
+        let ba = (dirs & INTO_A != 0)
+            .then(|| Shooter::of(self.samples, self.maps, k).factor_to(self.samples, i))
+            .flatten();
+        if ab.is_some() || ba.is_some() {
+            pending.push(Pending {
+                a,
+                b,
+                dirs,
+                first: probes.len(),
+                probes: 1,
+                kind: Kind::Leaf(ab, ba),
+            });
+            probes.push(Probe {
+                i: i as u32,
+                k: k as u32,
+                exact: [0.0; 2],
+                formula: [0.0; 2],
+                ray: Some(segments.len() as u32),
+            });
+            segments.push(segment(self.samples, self.lift, i, k));
+        }
     }
 
     /// Whether the links' formula is far from grazing at both ends (the centroids' direction

@@ -457,26 +457,9 @@ fn sweep(
     // workers during them.
     let inputs = RwLock::new(Inputs::default());
     let ranks = settings.exec.ranks;
-    let work = |mut group: Group| -> Result<Group> {
-        if !group.owned {
-            // Another rank's: its deliveries come in the exchange.
-            return Ok(group);
-        }
+    let work = |group: Group| -> Result<Group> {
         let inputs = inputs.read().unwrap_or_else(|e| e.into_inner());
-        let sources = Sources {
-            tree,
-            samples,
-            unshot: &inputs.unshot,
-            shooters: &inputs.shooters,
-        };
-        sources.gather(group.root, &group.links, &mut group.delivered);
-        if !inputs.scales.is_empty() {
-            let first = first_member(tree, group.root);
-            for (p, h) in group.delivered.iter_mut().enumerate() {
-                *h *= f64::from(inputs.scales[tree.order[first + p] as usize]);
-            }
-        }
-        Ok(group)
+        Ok(gather_group(group, tree, samples, &inputs))
     };
     let set = |unshot: &[DVec3], scales: &[f32]| {
         let mut inputs = inputs.write().unwrap_or_else(|e| e.into_inner());
@@ -555,6 +538,34 @@ fn sweep(
     linked.groups = groups;
     linked.rows = rows;
     Ok(())
+}
+
+/// One group's sweep: what its links deliver to its members from the shooters' unshot
+/// radiosity, each member's share scaled by its row scale (where the sweep has them). Another
+/// rank's group is left as it is: its deliveries come in the exchange.
+fn gather_group(
+    mut group: Group,
+    tree: &Tree,
+    samples: &crate::sampling::Samples,
+    inputs: &Inputs,
+) -> Group {
+    if !group.owned {
+        return group;
+    }
+    let sources = Sources {
+        tree,
+        samples,
+        unshot: &inputs.unshot,
+        shooters: &inputs.shooters,
+    };
+    sources.gather(group.root, &group.links, &mut group.delivered);
+    if !inputs.scales.is_empty() {
+        let first = first_member(tree, group.root);
+        for (p, h) in group.delivered.iter_mut().enumerate() {
+            *h *= f64::from(inputs.scales[tree.order[first + p] as usize]);
+        }
+    }
+    group
 }
 
 /// The groups' sweeps on the pipeline's workers, and their deliveries swapped between ranks.
