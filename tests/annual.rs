@@ -371,6 +371,7 @@ fn office_at(weather: &Weather, h: &meshlight::daylight::epw::WeatherHour) -> Sc
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn the_office_year_matches_one_moment_solves_hour_by_hour() {
     let weather = office_weather();
     let scene = Scene::load(concat!(

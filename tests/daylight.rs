@@ -463,6 +463,7 @@ fn the_sun_through_a_roof_opening_gives_its_direct_normal_illuminance() {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn the_sun_and_a_perez_sky_in_the_office_match_the_path_tracer() {
     // A clear spring noon (the sun by the SPA at 37° altitude, through the glazed south
     // window onto the floor): the meshless image on both backends against the path tracer,
@@ -556,6 +557,7 @@ fn office(file: &str, width: u32, height: u32) -> Scene {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn the_side_lit_office_matches_the_path_tracer() {
     // Overcast sky through the window, open and glazed: the meshless image at the defaults on
     // both backends against one path-traced image, over 4 × 4 blocks within 2% and in the mean

@@ -186,6 +186,7 @@ fn the_room_on_two_and_three_ranks_is_one_process_solve() {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn a_reduced_gallery_on_two_and_three_ranks_is_one_process_solve() {
     let scene = common::shipped_at("gallery", 96);
     let options = Options {

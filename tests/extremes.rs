@@ -140,6 +140,7 @@ fn brighter_walls_give_a_brighter_room() {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn scaling_the_scene_leaves_the_image_alone() {
     let room = Scene::load(shipped("room")).unwrap();
     let options = Options {
@@ -155,6 +156,7 @@ fn scaling_the_scene_leaves_the_image_alone() {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn scaling_the_lights_scales_the_image() {
     let room = Scene::load(shipped("room")).unwrap();
     let options = Options::default();
@@ -167,6 +169,7 @@ fn scaling_the_lights_scales_the_image() {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn one_sample_per_surface_still_gives_a_plausible_image() {
     let room = Scene::load(shipped("room")).unwrap();
     let (_, fine) = solve(&room, &Options::default());

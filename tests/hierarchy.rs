@@ -19,6 +19,7 @@ fn flat() -> Options {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn room_at_the_default_threshold_is_within_half_a_percent_of_the_flat_solve() {
     let scene = Scene::load(shipped("room")).unwrap();
     for backend in backends() {
@@ -134,6 +135,7 @@ fn queries(scene: &Scene, epsilon: f32, threshold: f64) -> (u64, usize) {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn from_n_to_4n_samples_queries_grow_less_than_five_times() {
     // A reduced gallery (big tiles, icosahedra); ε 0.6 → 0.28 about quadruples the samples
     // (every side keeps at least one, so halving ε alone gives less).
@@ -320,6 +322,7 @@ fn at_albedo_0_95_the_hierarchy_delivers_what_its_shooters_send() {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn at_albedo_0_95_the_hierarchy_reflects_as_much_light_as_the_flat_solver() {
     // The same samples (no adaptive rounds), shot to convergence: the light all surfaces
     // reflect, Σ B S, by the hierarchy and by the flat solver, over five seeds. A cluster link
@@ -357,6 +360,7 @@ fn at_albedo_0_95_the_hierarchy_reflects_as_much_light_as_the_flat_solver() {
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn after_adaptive_rounds_the_hierarchy_matches_the_flat_solver_block_by_block() {
     // The shipped room at the defaults (two adaptive rounds), 128²: over 4 × 4 blocks the
     // hierarchy's image against the flat solver's, the independent O(N²) transport. The tail
@@ -385,6 +389,7 @@ fn after_adaptive_rounds_the_hierarchy_matches_the_flat_solver_block_by_block() 
 }
 
 #[test]
+#[ignore = "full tier: a large or repeated solve (cargo test -- --include-ignored)"]
 fn on_artist_made_facets_the_hierarchy_matches_the_flat_solve_sample_by_sample() {
     // The atrium: columns of 48 facets, arches, vaults, cloths, most surfaces under 0.5 m², so
     // most nodes span several surfaces with something standing among their members. Both

@@ -56,6 +56,7 @@ fn region(image: &Image, (x0, x1): (u32, u32), (y0, y1): (u32, u32)) -> f64 {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn a_chrome_ball_and_a_glass_ball_in_the_cornell_box_match_the_path_tracer() {
     // 6,016 and 5,120 facets: every facet of both balls is curved, so the light they send onto
     // the walls comes by photons, and the glass ball focuses it into a caustic on the floor in
@@ -81,6 +82,7 @@ fn a_chrome_ball_and_a_glass_ball_in_the_cornell_box_match_the_path_tracer() {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn a_cab_of_five_mirrors_matches_the_path_tracer() {
     // Four mirror walls and a mirror ceiling (Ks 0.9): the light and the box seen in rows of
     // images to the horizon. The 64 chains of images listed carry the direct light of up to
@@ -99,6 +101,7 @@ fn a_cab_of_five_mirrors_matches_the_path_tracer() {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn a_glass_block_on_a_floor_matches_the_path_tracer() {
     // Its refracted light is photons' (a block is no slab: shadow rays do not pass it), its
     // faces' reflections images'. Within 2.5% over blocks (measured 1.43%; at 128², where
@@ -155,6 +158,7 @@ fn blocks_seeing_lights(scene: &Scene) -> Vec<bool> {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn glossy_plates_under_sphere_lights_match_the_path_tracer() {
     // Veach's test: plates of GGX α 0.005 to 0.1 under four sphere lights of 320 facets each
     // (radii 0.03 to 0.9 m, the same power): every plate shows every light as a highlight.
@@ -192,6 +196,7 @@ fn glossy_plates_under_sphere_lights_match_the_path_tracer() {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn in_the_caustic_a_grids_chains_and_the_samples_photons_agree() {
     // Two ways to the light a glass ball focuses onto the floor: the samples' photons (from
     // the light), and a grid's chains (from its points, meeting the light through the ball).

@@ -30,6 +30,7 @@ fn spp(spp: u32) -> PathOptions {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn an_ideal_mirror_wall_shows_the_room_doubled() {
     // Everything the unmirrored half sees of light by the mirror, it sees of the doubled room
     // through the plane x = 2: the two path-traced images agree but for noise. The camera
@@ -67,6 +68,7 @@ fn an_ideal_mirror_wall_shows_the_room_doubled() {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn two_mirror_walls_in_a_corner_show_the_room_four_times() {
     // Mirrors at x = 2 and z = 2: the light has three images (one in each mirror, one in
     // both), so light sampling needs chains of two mirrors. The reference is the room

@@ -289,6 +289,7 @@ fn shipped_at(name: &str, size: u32) -> Scene {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn mirror_glossy_and_glass_rooms_match_the_path_tracer() {
     // The path tracer shares no transport code with the solver (only the scattering formulas
     // of `material`, which the furnaces above check on their own). At defaults the meshless
@@ -335,6 +336,7 @@ fn mirror_glossy_and_glass_rooms_match_the_path_tracer() {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn the_meshless_mirror_room_matches_the_room_doubled() {
     // The image method's own check: a room whose far wall is an ideal mirror lights its half
     // exactly as the room doubled across the mirror's plane (with the light doubled) lights
@@ -431,6 +433,7 @@ fn a_scene_without_specular_materials_ignores_the_specular_knobs() {
 }
 
 #[test]
+#[ignore = "full tier: a reference comparison at many samples (cargo test -- --include-ignored)"]
 fn specular_scenes_give_the_same_numbers_on_one_thread_and_two() {
     // Chains, images and camera paths through mirrors, a glossy floor and glass, and photons
     // (through a glass block, and along the chains a cab of mirrors leaves to them): every

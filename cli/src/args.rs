@@ -197,7 +197,7 @@ pub struct RenderFlags {
     pub direct_rays: Option<u32>,
     /// Meshless: rays gathered over the hemisphere at a camera hit within its samples' reach of
     /// another surface (contacts, creases: exact visibility there); 0 interpolates there too
-    /// [default: the preset's: preview 0, default 64, final 256].
+    /// [default: the preset's: preview 0, default 32, final 128].
     #[arg(long,
           value_parser = clap::value_parser!(u32).range(0..=i64::from(meshlight::render::MAX_GATHER_RAYS)))]
     pub gather_rays: Option<u32>,

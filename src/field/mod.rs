@@ -2,7 +2,7 @@
 //! what reading that light at any other point takes (the surfaces in 2D, the samples' index,
 //! the sides other geometry stands on, the samples something hovers over). The solver builds
 //! it; the render, the grids, the PLY writer and the specular chains' ends only read it, through
-//! [`interpolate`] and the accessors here. Where the samples lie (`sampling::Layout`) is the
+//! `interpolate` and the accessors here. Where the samples lie (`sampling::Layout`) is the
 //! solver's to grow and the field's to keep.
 
 pub(crate) mod interpolate;

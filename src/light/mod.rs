@@ -690,21 +690,7 @@ impl DirectLight {
         if !emitter.facets.is_empty() {
             return self.facet_rays(emitter, seen, rng, tally, unoccluded);
         }
-        let Seen {
-            x,
-            n,
-            from,
-            slot,
-            chain,
-            straight,
-        } = *seen;
-        let Tally {
-            analytic,
-            factor,
-            weights,
-            paths,
-            rays,
-        } = tally;
+        let (x, n) = (seen.x, seen.n);
         // Emitters light only what lies in front of them.
         let height = emitter.normal.dot(x) - emitter.offset;
         if height <= 0.0 {
@@ -718,11 +704,7 @@ impl DirectLight {
         if irradiance <= 0.0 {
             return;
         }
-        analytic[slot] = emitter.ke * irradiance;
-        if !emitter.reflects && straight {
-            factor[slot] = irradiance / std::f64::consts::PI;
-        }
-        *unoccluded += (emitter.ke * irradiance).element_sum();
+        tally.exact(seen, emitter, irradiance, unoccluded);
         // Near emitters are drawn uniformly in solid angle, far ones (or ones rounding defeats)
         // uniformly in area: see `spherical`.
         let (centre, radius) = emitter.bounds;
@@ -769,16 +751,7 @@ impl DirectLight {
             } else {
                 f64::from(cos_x * cos_y / (dist2 * dist2))
             };
-            weights[slot].0 += weight;
-            let to = y + self.lift * emitter.normal;
-            if let (Some(&k), Some((spec, _))) = (chain.first(), &self.specular) {
-                if !spec.reflectors[k as usize].may_pass(from, to) {
-                    // Misses the window: it counts, and brings nothing, without a path.
-                    continue;
-                }
-            }
-            paths.push(LightPath { from, to, chain });
-            rays.push((slot, weight));
+            self.shadow_ray(seen, y + self.lift * emitter.normal, weight, tally);
         }
     }
 }
@@ -796,21 +769,7 @@ impl DirectLight {
         tally: &mut Tally<'c>,
         unoccluded: &mut f64,
     ) {
-        let Seen {
-            x,
-            n,
-            from,
-            slot,
-            chain,
-            straight,
-        } = *seen;
-        let Tally {
-            analytic,
-            factor,
-            weights,
-            paths,
-            rays,
-        } = tally;
+        let (x, n) = (seen.x, seen.n);
         // Per facing triangle: (triangle, its irradiance, cumulative irradiance).
         let mut facing: Vec<(usize, f64, f64)> = Vec::new();
         let mut irradiance = 0.0;
@@ -829,11 +788,7 @@ impl DirectLight {
         if irradiance <= 0.0 {
             return;
         }
-        analytic[slot] = emitter.ke * irradiance;
-        if !emitter.reflects && straight {
-            factor[slot] = irradiance / std::f64::consts::PI;
-        }
-        *unoccluded += (emitter.ke * irradiance).element_sum();
+        tally.exact(seen, emitter, irradiance, unoccluded);
         let count = self.light_samples;
         let shift = (rng.random::<f64>(), rng.random::<f64>());
         for s in 0..count {
@@ -858,16 +813,28 @@ impl DirectLight {
             // The integrand cos·cos/r² over the density (e/E)/A of the point, up to E.
             let area = 0.5 * f64::from((b - a).cross(c - a).length());
             let weight = f64::from(cos_x * cos_y / (dist2 * dist2)) * area / e;
-            weights[slot].0 += weight;
-            let to = y + self.lift * normal;
-            if let (Some(&k), Some((spec, _))) = (chain.first(), &self.specular) {
-                if !spec.reflectors[k as usize].may_pass(from, to) {
-                    continue;
-                }
-            }
-            paths.push(LightPath { from, to, chain });
-            rays.push((slot, weight));
+            self.shadow_ray(seen, y + self.lift * normal, weight, tally);
         }
+    }
+}
+
+impl DirectLight {
+    /// One shadow ray of weight `weight` from the receiver `seen` to the point `to` (lifted off
+    /// its emitter): it counts in the slot's weights, and is traced unless its line misses the
+    /// chain's first window (then it brings nothing, without a path).
+    fn shadow_ray<'c>(&self, seen: &Seen<'c>, to: Vec3, weight: f64, tally: &mut Tally<'c>) {
+        tally.weights[seen.slot].0 += weight;
+        if let (Some(&k), Some((spec, _))) = (seen.chain.first(), &self.specular) {
+            if !spec.reflectors[k as usize].may_pass(seen.from, to) {
+                return;
+            }
+        }
+        tally.paths.push(LightPath {
+            from: seen.from,
+            to,
+            chain: seen.chain,
+        });
+        tally.rays.push((seen.slot, weight));
     }
 }
 
@@ -882,6 +849,19 @@ struct Seen<'c> {
     slot: usize,
     chain: &'c [u32],
     straight: bool,
+}
+
+impl Tally<'_> {
+    /// An emitter's unoccluded light at a receiver's slot: its analytic irradiance (Lambert's,
+    /// `irradiance` per unit radiance), the form factor to it where it reflects nothing and is
+    /// seen straight, and its share of `unoccluded`.
+    fn exact(&mut self, seen: &Seen, emitter: &Emitter, irradiance: f64, unoccluded: &mut f64) {
+        self.analytic[seen.slot] = emitter.ke * irradiance;
+        if !emitter.reflects && seen.straight {
+            self.factor[seen.slot] = irradiance / std::f64::consts::PI;
+        }
+        *unoccluded += (emitter.ke * irradiance).element_sum();
+    }
 }
 
 /// Per slot, what a batch of receivers' area lights add up to: the analytic irradiance, the

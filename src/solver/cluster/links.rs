@@ -309,35 +309,46 @@ impl Linker<'_> {
                 }
             }
         } else if negligible && rays > 0 {
-            // Faint and partly visible: a receiver takes the share of the shooter its probes
-            // see, unless it is a cluster something hovers close in front of (a gap its
-            // members may hide in, which would trap the light) or one holding a sample in or
-            // beside such a gap (the fixture shades it from much of the room, and the share
-            // would light it as its neighbours): that one is refined.
-            let mut to_leaf = 0;
-            let mut refine = 0;
-            for (dir, receiver) in [(INTO_B, p.b), (INTO_A, p.a)] {
-                if p.dirs & dir != 0 {
-                    let node = (!receiver.is_leaf()).then(|| &self.tree.nodes[receiver.index()]);
-                    if node.is_none_or(|n| !(n.sheltered || n.holds_hovered)) {
-                        to_leaf |= dir;
-                    } else {
-                        refine |= dir;
-                    }
-                }
-            }
-            self.cluster_links(p, to_leaf, [factor(0), factor(1)], found, same_group);
-            if refine != 0 {
-                self.split(
-                    Pair {
-                        dirs: refine,
-                        ..pair_of(p)
-                    },
-                    stack,
-                );
-            }
+            self.faint_links(p, [factor(0), factor(1)], found, stack, same_group);
         } else {
             self.split(pair_of(p), stack);
+        }
+    }
+
+    /// A faint, partly visible pair: a receiver takes the share of the shooter its probes see
+    /// (`factors`, each way), unless it is a cluster something hovers close in front of (a gap
+    /// its members may hide in, which would trap the light) or one holding a sample in or
+    /// beside such a gap (the fixture shades it from much of the room, and the share would
+    /// light it as its neighbours): that one is refined.
+    fn faint_links(
+        &self,
+        p: &Pending,
+        factors: [f32; 2],
+        found: &mut Found,
+        stack: &mut Vec<Pair>,
+        same_group: bool,
+    ) {
+        let mut to_leaf = 0;
+        let mut refine = 0;
+        for (dir, receiver) in [(INTO_B, p.b), (INTO_A, p.a)] {
+            if p.dirs & dir != 0 {
+                let node = (!receiver.is_leaf()).then(|| &self.tree.nodes[receiver.index()]);
+                if node.is_none_or(|n| !(n.sheltered || n.holds_hovered)) {
+                    to_leaf |= dir;
+                } else {
+                    refine |= dir;
+                }
+            }
+        }
+        self.cluster_links(p, to_leaf, factors, found, same_group);
+        if refine != 0 {
+            self.split(
+                Pair {
+                    dirs: refine,
+                    ..pair_of(p)
+                },
+                stack,
+            );
         }
     }
 
