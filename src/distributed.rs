@@ -318,34 +318,6 @@ pub(crate) fn gather_shares<T, const W: usize>(
     Ok(())
 }
 
-/// [`for_chunks_halting`](crate::parallel::for_chunks_halting) over this rank's run of
-/// `out` ([`share_of`]), then every rank's run to every rank as `W` numbers an item. Whether
-/// every rank went through its run (a Stop on any rank: no; a chunk that gave up on the
-/// [`Halt`](crate::parallel::Halt) must then not be read).
-pub(crate) fn for_share<T: Send, const W: usize>(
-    exec: crate::exec::Exec,
-    out: &mut [T],
-    chunk: usize,
-    f: impl Fn(usize, &mut [T], &crate::parallel::Halt) -> Result<()> + Sync,
-    report: crate::parallel::Report,
-    put: impl Fn(&T) -> [f64; W],
-    take: impl Fn(&[f64]) -> T,
-) -> Result<bool> {
-    let ranks = exec.ranks;
-    let mine = share_of(ranks, out.len(), chunk);
-    let offset = mine.start;
-    let all = crate::parallel::for_chunks_halting(
-        &mut out[mine],
-        chunk,
-        exec.threads,
-        |first, part, halt| f(offset + first, part, halt),
-        report,
-    )?;
-    let all = !any(ranks, !all)?;
-    gather_shares(ranks, out, chunk, put, take)?;
-    Ok(all)
-}
-
 /// Lists filled rank by rank (each rank the lists it [`deals`]) to every rank, as `W`
 /// numbers an item.
 pub(crate) fn share_lists<T, const W: usize>(

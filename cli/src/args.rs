@@ -278,7 +278,7 @@ pub struct SweepArgs {
     /// Keys: every solver flag (epsilon, epsilon-scale, zeta, alpha, rounds, light-samples, …),
     /// preset, backend and the render flags (supersample, direct-rays, gather-rays, glossy-rays,
     /// spp, patch-size); an unknown key's error lists them all.
-    #[arg(long, required = true, value_parser = super::sweep::parse_vary)]
+    #[arg(long, required = true, value_parser = parse_vary)]
     pub vary: Vec<(String, Vec<String>)>,
     /// How each run computes its image.
     #[arg(long, default_value = "meshless")]
@@ -303,6 +303,41 @@ pub struct SweepArgs {
     /// reference traced with --seed.
     #[arg(long)]
     pub pathtrace_seconds: Option<f64>,
+}
+
+/// The settings `--vary` knows, as the command line spells them: the solver's knob table, then
+/// the preset, the backend and the render flags.
+pub fn vary_keys() -> Vec<String> {
+    let knobs = meshlight::solver::KNOBS
+        .iter()
+        .map(|k| k.name.replace('_', "-"));
+    knobs
+        .chain(RENDER_KEYS.iter().map(|k| k.to_string()))
+        .collect()
+}
+
+/// Parses `key=v1,v2,...`.
+pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String> {
+    let (key, values) = s
+        .split_once('=')
+        .ok_or_else(|| format!("'{s}' is not key=value1,value2,..."))?;
+    let key = key.trim().replace('_', "-");
+    let keys = vary_keys();
+    if !keys.contains(&key) {
+        return Err(format!(
+            "unknown setting '{key}' (known: {})",
+            keys.join(", ")
+        ));
+    }
+    let values: Vec<String> = values
+        .split(',')
+        .map(|v| v.trim().to_string())
+        .filter(|v| !v.is_empty())
+        .collect();
+    if values.is_empty() {
+        return Err(format!("'{s}' gives {key} no values"));
+    }
+    Ok((key, values))
 }
 
 /// `bench-vis`'s arguments.

@@ -17,17 +17,6 @@ use plotters::style::RGBColor;
 use super::plot::{error_time_png, Series};
 use crate::Method;
 
-/// The settings `--vary` knows, as the command line spells them: the solver's knob table, then
-/// the preset, the backend and the render flags.
-fn keys() -> Vec<String> {
-    let knobs = meshlight::solver::KNOBS
-        .iter()
-        .map(|k| k.name.replace('_', "-"));
-    knobs
-        .chain(crate::args::RENDER_KEYS.iter().map(|k| k.to_string()))
-        .collect()
-}
-
 /// Added to the seed of the path tracer's curve, so it shares no random numbers with a
 /// reference traced with the sweep's own seed.
 const CURVE_SEED: u64 = 0x9E37_79B9;
@@ -71,30 +60,6 @@ impl From<crate::SweepArgs> for Sweep {
             pathtrace_seconds: a.pathtrace_seconds,
         }
     }
-}
-
-/// Parses `key=v1,v2,...`.
-pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String> {
-    let (key, values) = s
-        .split_once('=')
-        .ok_or_else(|| format!("'{s}' is not key=value1,value2,..."))?;
-    let key = key.trim().replace('_', "-");
-    let keys = keys();
-    if !keys.contains(&key) {
-        return Err(format!(
-            "unknown setting '{key}' (known: {})",
-            keys.join(", ")
-        ));
-    }
-    let values: Vec<String> = values
-        .split(',')
-        .map(|v| v.trim().to_string())
-        .filter(|v| !v.is_empty())
-        .collect();
-    if values.is_empty() {
-        return Err(format!("'{s}' gives {key} no values"));
-    }
-    Ok((key, values))
 }
 
 /// Whether `method` uses the setting `key`: a sweep over a setting the method ignores would
@@ -605,6 +570,7 @@ fn plot(path: &Path, scene: &Scene, method: Method, rows: &[Row], curve: &[Row])
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::args::parse_vary;
 
     #[test]
     fn every_key_is_a_flag_of_the_sweep_and_every_setting_flag_a_key() {
@@ -612,7 +578,7 @@ mod tests {
         let command = crate::args::Args::command();
         let sweep = command.find_subcommand("sweep").unwrap();
         let flags: Vec<&str> = sweep.get_arguments().filter_map(|a| a.get_long()).collect();
-        let keys = keys();
+        let keys = crate::args::vary_keys();
         for key in &keys {
             assert!(flags.contains(&key.as_str()), "--vary {key} is not a flag");
         }

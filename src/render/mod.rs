@@ -302,8 +302,7 @@ fn draw(
     // Each rank a run of the rows (a Stop heard before leaves them all black).
     // Every ray seeds its own shadow rays by its pixel: the stage needs no seed.
     let exec = crate::exec::Exec::new(options.threads, 0, ranks);
-    let all = crate::distributed::for_share(
-        exec,
+    let all = exec.for_share(
         &mut centre,
         w,
         |first, out, _: &_| trace(first, out),
@@ -341,8 +340,7 @@ fn draw(
         Ok(())
     };
     // Each rank a run of the edge pixels (none after a Stop: `edges` is empty then).
-    let refined_all = crate::distributed::for_share(
-        exec,
+    let refined_all = exec.for_share(
         &mut refined,
         16,
         |first, out, _: &_| refine(first, out),

@@ -104,8 +104,7 @@ pub(crate) fn errors(
         }
         Ok(())
     };
-    let all = crate::distributed::for_share(
-        exec,
+    let all = exec.for_share(
         &mut out,
         1024,
         error,

@@ -12,7 +12,6 @@ pub(crate) mod basis;
 mod cluster;
 mod flat;
 mod form_factor;
-mod knobs;
 mod normalise;
 mod options;
 mod phases;
@@ -41,7 +40,7 @@ use crate::scene::Scene;
 pub use crate::specular::{summary as specular_summary, SpecularSummary, MAX_SPECULAR_DEPTH};
 use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
-pub use knobs::{knob, Knob, KNOBS, MAX_PIPELINE_CAPACITY, MAX_THREADS};
+pub use options::{knob, Knob, KNOBS, MAX_PIPELINE_CAPACITY, MAX_THREADS};
 pub use options::{
     Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH, MAX_PHOTONS,
     MAX_SPECULAR_RAYS,

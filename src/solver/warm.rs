@@ -115,8 +115,7 @@ pub(crate) fn start(
         Ok(())
     };
     // Each rank a run of the new samples.
-    crate::distributed::for_share(
-        exec,
+    exec.for_share(
         &mut out,
         256,
         |first, out, _: &_| each(first, out),
