@@ -56,8 +56,8 @@ pub struct Options {
     /// partly visible link whose whole transfer is below a quarter of the error threshold
     /// carries the visible share its probes measured (no wall is ever crossed: clusters never
     /// straddle an occluder). Exact visibility sharpens faint penumbrae at a cost that grows
-    /// faster than the samples: on the shipped gallery 3.95 s instead of 3.26 s for about the
-    /// same error against the flat solve (MAE/mean 0.21% and 0.20%); at 179k samples 97.6 M
+    /// faster than the samples: on the shipped gallery 10.2 s instead of 9.1 s for about the
+    /// same error against the flat solve (MAE/mean 0.35% and 0.34%); at 179k samples 97.6 M
     /// links and 2.57 GB instead of 5.1 M and 0.71 GB (`docs/performance.md`).
     pub exact_visibility: bool,
     /// The memory budget, bytes: every large structure counts against it. The samples and
