@@ -32,9 +32,9 @@ impl<'a> Exec<'a> {
     }
 
     /// [`for_chunks_halting`](crate::parallel::for_chunks_halting) over this rank's run of
-    /// `out` ([`share_of`](crate::distributed::share_of)), then every rank's run to every rank as `W` numbers an item. Whether
-    /// every rank went through its run (a Stop on any rank: no; a chunk that gave up on the
-    /// [`Halt`](crate::parallel::Halt) must then not be read).
+    /// `out` ([`share_of`](crate::distributed::share_of)), then every rank's run to every rank
+    /// as `W` numbers an item. Whether every rank went through its run (a Stop on any rank: no;
+    /// a chunk that gave up on the [`Halt`](crate::parallel::Halt) must then not be read).
     pub(crate) fn for_share<T: Send, const W: usize>(
         self,
         out: &mut [T],

@@ -69,6 +69,29 @@ struct Walk {
     samples: Vec<LightSample>,
 }
 
+impl Branch {
+    /// The branch after this one's bounce: from `origin` along `dir`, carrying `weight`, one
+    /// deeper, the rest as this one's (its id and what it is for the caller to set).
+    fn bounce(&self, origin: Vec3, dir: Vec3, weight: DVec3) -> Branch {
+        Branch {
+            ray: Ray {
+                origin,
+                dir,
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            },
+            origin: self.origin,
+            weight,
+            depth: self.depth + 1,
+            traced: self.traced,
+            glossed: self.glossed,
+            main: self.main,
+            id: self.id,
+            lobe_pdf: None,
+        }
+    }
+}
+
 /// A light sample's shadow path waiting for its answer.
 struct Shadowed {
     origin: usize,
@@ -255,20 +278,10 @@ impl Shader<'_> {
                 continue;
             }
             next.push(Branch {
-                ray: Ray {
-                    origin: on(*d),
-                    dir: d.as_vec3(),
-                    t_min: 0.0,
-                    t_max: f32::INFINITY,
-                },
-                origin: b.origin,
-                weight,
-                depth: b.depth + 1,
                 traced: b.traced && b.depth == 0,
-                glossed: b.glossed,
                 main: b.main && k == heaviest,
                 id: side_seed(u64::from(b.id), b.depth, k as u64) as u32,
-                lobe_pdf: None,
+                ..b.bounce(on(*d), d.as_vec3(), weight)
             });
         }
     }
@@ -326,20 +339,12 @@ impl Shader<'_> {
                 continue;
             }
             next.push(Branch {
-                ray: Ray {
-                    origin: from,
-                    dir: d.as_vec3(),
-                    t_min: 0.0,
-                    t_max: f32::INFINITY,
-                },
-                origin: b.origin,
-                weight,
-                depth: b.depth + 1,
                 traced: false,
                 glossed: true,
                 main: false,
                 id: side_seed(u64::from(b.id), 1000 + j, u64::from(b.depth)) as u32,
                 lobe_pdf: Some((lobe.pdf(d), n)),
+                ..b.bounce(from, d.as_vec3(), weight)
             });
         }
     }

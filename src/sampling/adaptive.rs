@@ -16,7 +16,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::poisson::side_seed;
-use super::{surface_of, Layout, Samples, SideIndex};
+use super::{surface_of, Layout, Samples};
 use crate::error::Result;
 use crate::exec::Exec;
 use crate::parallel::{for_chunks, Report};
@@ -51,8 +51,6 @@ pub struct Refinement {
 /// Settings of one refinement.
 #[derive(Clone, Copy, Debug)]
 pub struct RefineSettings {
-    /// Initial spacing ε.
-    pub epsilon: f32,
     /// Relative error threshold ζ.
     pub zeta: f32,
     /// Area weight parameter α (eq. 5), used for eq. 8's weights.
@@ -132,7 +130,7 @@ pub(crate) fn refine(
     exec: Exec,
     report: Report,
 ) -> Result<Refinement> {
-    let (maps, index, ranks) = (layout.maps(), layout.index(), exec.ranks);
+    let (maps, ranks) = (layout.maps(), exec.ranks);
     // The errors take the first half of the phase's share, the darts the second.
     let Some(errors) = errors(samples, layout, vis, radiosity, exec, &mut |f| {
         report(0.5 * f)
@@ -143,7 +141,7 @@ pub(crate) fn refine(
     };
     let mut result = Refinement::default();
     let old = samples.len();
-    let mut discs = discs_to_fill(samples, index, &errors, settings);
+    let mut discs = discs_to_fill(samples, layout, &errors, settings);
     result.refined = discs.len();
     // The discs side by side (each side's in sample order), filled side by side in parallel:
     // a new sample is tested against the old samples and its own side's new ones only.
@@ -227,11 +225,11 @@ pub(crate) fn refine(
 /// radius, how many new ones); their radii shrink to make room.
 fn discs_to_fill(
     samples: &mut Samples,
-    index: &SideIndex,
+    layout: &Layout,
     errors: &[f64],
     settings: RefineSettings,
 ) -> Vec<(usize, f32, u32)> {
-    let min_radius = settings.epsilon / MAX_SPLIT;
+    let (index, min_radius) = (layout.index(), layout.epsilon() / MAX_SPLIT);
     let mut near = Vec::new();
     let mut discs = Vec::new();
     for (k, &e) in errors.iter().enumerate() {
@@ -312,7 +310,7 @@ fn fill_discs(
     out: &mut Vec<(Vec2, f32)>,
 ) {
     let (maps, index) = (layout.maps(), layout.index());
-    let eps = settings.epsilon;
+    let eps = layout.epsilon();
     let min_radius = eps / MAX_SPLIT;
     let cell = eps / 2.0;
     let r_weights = 2.0 * eps;

@@ -103,7 +103,7 @@ pub(crate) fn shoot(
     let samples = state.samples;
     let n = samples.len();
     let mut stats = ShootStats::new();
-    let threads = settings.exec.threads.max(1);
+    let threads = settings.exec.threads;
     let chunk = n.div_ceil(4 * threads).max(512);
     // The bit matrix is worth it within half the memory budget only.
     let memo_bytes = Memo::bytes(n);

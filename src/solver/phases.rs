@@ -684,7 +684,6 @@ impl<'a> Solve<'a> {
             self.vis,
             &solution.field.radiosity,
             RefineSettings {
-                epsilon: self.epsilon,
                 zeta: options.zeta,
                 alpha: options.alpha,
                 round: round as u16,

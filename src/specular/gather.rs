@@ -123,6 +123,31 @@ struct Link {
     node: u32,
 }
 
+impl Link {
+    /// The link after this one's bounce: from `origin` along `dir`, carrying `weight`, one
+    /// deeper; its random stream, and what it says of the images, for the caller to set.
+    fn bounce(&self, origin: Vec3, dir: Vec3, weight: DVec3) -> Link {
+        Link {
+            ray: Ray {
+                origin,
+                dir,
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            },
+            receiver: self.receiver,
+            normal: self.normal,
+            weight,
+            depth: self.depth + 1,
+            glossy: self.glossy,
+            lobe_pdf: None,
+            first: None,
+            rng: self.rng,
+            straight: self.straight,
+            node: self.node,
+        }
+    }
+}
+
 impl Chains<'_> {
     /// Whether the images carry a chain after it reflects (`reflected`) on or crosses
     /// `surface` from its back or front: (straight so far, its node in the tree of chains).
@@ -491,22 +516,10 @@ impl Chains<'_> {
             // (`material::branches`).
             let (straight, node) = self.carried(l, at.tri.surface, back, j == 0);
             next.push(Link {
-                ray: Ray {
-                    origin: self.off(at, *d),
-                    dir: d.as_vec3(),
-                    t_min: 0.0,
-                    t_max: f32::INFINITY,
-                },
-                receiver: l.receiver,
-                normal: l.normal,
-                weight,
-                depth: l.depth + 1,
-                glossy: l.glossy,
-                lobe_pdf: None,
-                first: None,
                 rng: side_seed(l.rng, j as u32, 31),
                 straight,
                 node,
+                ..l.bounce(self.off(at, *d), d.as_vec3(), weight)
             });
         }
     }
@@ -553,22 +566,13 @@ impl Chains<'_> {
         let weight = l.weight * w;
         if weight.max_element() >= NEGLIGIBLE * self.share() {
             next.push(Link {
-                ray: Ray {
-                    origin: from,
-                    dir: d.as_vec3(),
-                    t_min: 0.0,
-                    t_max: f32::INFINITY,
-                },
-                receiver: l.receiver,
-                normal: l.normal,
-                weight,
-                depth: l.depth + 1,
                 glossy: true,
                 lobe_pdf: Some(lobe.pdf(d)),
                 first,
                 rng: side_seed(l.rng, 7, 37),
                 straight: false,
                 node: ChainTree::OFF,
+                ..l.bounce(from, d.as_vec3(), weight)
             });
         }
     }

@@ -315,7 +315,7 @@ fn link_groups(
     stats: &mut ShootStats,
     report: &mut dyn FnMut(Tick) -> Control,
 ) -> Result<(Vec<Group>, ControlFlow<()>)> {
-    let threads = settings.exec.threads.max(1);
+    let threads = settings.exec.threads;
     let ranks = settings.exec.ranks;
     let (me, size) = (ranks.rank(), ranks.size().max(1));
     let pairs: Vec<(usize, usize)> = (0..roots.len())
@@ -472,69 +472,63 @@ fn sweep(
         inputs.scales.clear();
         inputs.scales.extend_from_slice(scales);
     };
-    let rows = with_pool(
-        settings.exec.threads.max(1),
-        settings.capacity,
-        &work,
-        |pool| {
-            let mut sweeps = Sweeps {
-                pool,
-                tree,
-                ranks,
-                counts,
-            };
-            // Row sums: one sweep with unit radiosity everywhere, unscaled. Each sample's
-            // normalised row sum is by reciprocity also the share of what it shoots that the
-            // links should deliver (see `balance`).
-            let mut rows = given;
-            if settings.normalise {
-                if let Some(sums) = row_sums(&mut sweeps, &mut groups, state, stats, &set)? {
-                    rows = sums;
-                }
+    let rows = with_pool(settings.exec.threads, settings.capacity, &work, |pool| {
+        let mut sweeps = Sweeps {
+            pool,
+            tree,
+            ranks,
+            counts,
+        };
+        // Row sums: one sweep with unit radiosity everywhere, unscaled. Each sample's
+        // normalised row sum is by reciprocity also the share of what it shoots that the
+        // links should deliver (see `balance`).
+        let mut rows = given;
+        if settings.normalise {
+            if let Some(sums) = row_sums(&mut sweeps, &mut groups, state, stats, &set)? {
+                rows = sums;
             }
-            let max_sweeps = if settings.max_shots == u64::MAX {
-                MAX_SWEEPS
-            } else {
-                settings.max_shots
-            };
-            let mut first = true;
-            let mut last_shot = None;
-            loop {
-                let total: f64 = (0..n)
-                    .map(|k| unshot_power(state.unshot[k], samples.area[k]))
-                    .sum();
-                stats.unshot_fraction = total / emitted;
-                if first {
-                    stats.initial_unshot_fraction = stats.unshot_fraction;
-                    first = false;
-                }
-                if let Some(stop) = settled(stats, settings, total, max_sweeps) {
-                    stats.stop = stop;
-                    break;
-                }
-                let stop = report(Tick::shooting(
-                    stats.shots,
-                    stats.unshot_fraction,
-                    stats.initial_unshot_fraction,
-                    settings.tolerance,
-                )) == Control::Stop;
-                if crate::distributed::any(ranks, stop)? {
-                    stats.stop = StopReason::Stopped;
-                    break;
-                }
-                let shot =
-                    shoot_once(&mut sweeps, &mut groups, state, &rows, &set, &inputs, stats)?;
-                stats.shots += 1;
-                last_shot = Some(shot);
+        }
+        let max_sweeps = if settings.max_shots == u64::MAX {
+            MAX_SWEEPS
+        } else {
+            settings.max_shots
+        };
+        let mut first = true;
+        let mut last_shot = None;
+        loop {
+            let total: f64 = (0..n)
+                .map(|k| unshot_power(state.unshot[k], samples.area[k]))
+                .sum();
+            stats.unshot_fraction = total / emitted;
+            if first {
+                stats.initial_unshot_fraction = stats.unshot_fraction;
+                first = false;
             }
-            if stats.stop == StopReason::Converged {
-                if let Some(shot) = last_shot {
-                    tail(state, shot);
-                }
+            if let Some(stop) = settled(stats, settings, total, max_sweeps) {
+                stats.stop = stop;
+                break;
             }
-            Ok(rows)
-        },
-    )?;
+            let stop = report(Tick::shooting(
+                stats.shots,
+                stats.unshot_fraction,
+                stats.initial_unshot_fraction,
+                settings.tolerance,
+            )) == Control::Stop;
+            if crate::distributed::any(ranks, stop)? {
+                stats.stop = StopReason::Stopped;
+                break;
+            }
+            let shot = shoot_once(&mut sweeps, &mut groups, state, &rows, &set, &inputs, stats)?;
+            stats.shots += 1;
+            last_shot = Some(shot);
+        }
+        if stats.stop == StopReason::Converged {
+            if let Some(shot) = last_shot {
+                tail(state, shot);
+            }
+        }
+        Ok(rows)
+    })?;
     linked.groups = groups;
     linked.rows = rows;
     Ok(())
