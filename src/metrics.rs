@@ -119,6 +119,40 @@ pub fn signed_error_map(image: &Image, reference: &Image) -> Result<Vec<f32>> {
         .collect())
 }
 
+/// How far above its 3 × 3 neighbourhood's median a pixel must be to count as a sparkle
+/// ([`sparkles`]).
+pub const SPARKLE_RATIO: f32 = 1.3;
+
+/// Sparkles: pixels (not on the border) whose brightness (the mean of their channels) exceeds
+/// `ratio` times the median of their 3 × 3 neighbourhood, themselves included. An isolated
+/// bright pixel is one; an edge or a highlight a few pixels wide is not, since the median
+/// then lies among the bright ones. A converged render of a scene of diffuse surfaces has
+/// few; each one in an image is noise a viewer sees as a white dot.
+pub fn sparkles(image: &Image, ratio: f32) -> Result<usize> {
+    image.check()?;
+    let (w, h) = (image.width as usize, image.height as usize);
+    let lum: Vec<f32> = image.pixels.iter().map(|p| p.element_sum() / 3.0).collect();
+    let mut count = 0;
+    let mut window = [0.0f32; 9];
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            let mut k = 0;
+            for yy in y - 1..=y + 1 {
+                for xx in x - 1..=x + 1 {
+                    window[k] = lum[yy * w + xx];
+                    k += 1;
+                }
+            }
+            window.sort_unstable_by(f32::total_cmp);
+            let v = lum[y * w + x];
+            if v > ratio * window[4] && v > 0.0 {
+                count += 1;
+            }
+        }
+    }
+    Ok(count)
+}
+
 fn same_size(image: &Image, reference: &Image) -> Result<()> {
     for (name, i) in [("image", image), ("reference", reference)] {
         if i.pixels.len() as u64 != u64::from(i.width) * u64::from(i.height) {
@@ -148,6 +182,34 @@ fn same_size(image: &Image, reference: &Image) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn field_of(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> Image {
+        let pixels = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| Vec3::splat(f(x, y)))
+            .collect();
+        Image {
+            width,
+            height,
+            pixels,
+        }
+    }
+
+    #[test]
+    fn a_lone_bright_pixel_is_a_sparkle_and_a_line_three_wide_is_not() {
+        // One pixel at 1.5 on a field of 1 stands above its neighbourhood's median (1); a
+        // band three pixels wide at 2 does not: its middle's 3 × 3 median is 2, and its edges'
+        // is 2 as well (six of nine in the band).
+        let lone = field_of(8, 8, |x, y| if (x, y) == (4, 3) { 1.5 } else { 1.0 });
+        assert_eq!(sparkles(&lone, SPARKLE_RATIO).unwrap(), 1);
+        let just_under = field_of(8, 8, |x, y| if (x, y) == (4, 3) { 1.29 } else { 1.0 });
+        assert_eq!(sparkles(&just_under, SPARKLE_RATIO).unwrap(), 0);
+        let band = field_of(8, 8, |x, _| if (3..6).contains(&x) { 2.0 } else { 1.0 });
+        assert_eq!(sparkles(&band, SPARKLE_RATIO).unwrap(), 0);
+        // On the border a pixel has no full neighbourhood: not counted.
+        let edge = field_of(8, 8, |x, y| if (x, y) == (0, 3) { 5.0 } else { 1.0 });
+        assert_eq!(sparkles(&edge, SPARKLE_RATIO).unwrap(), 0);
+    }
 
     #[test]
     fn block_averages_by_hand() {

@@ -414,6 +414,12 @@ fn compare(
         e.reference_mean[1],
         e.reference_mean[2]
     );
+    let ratio = meshlight::metrics::SPARKLE_RATIO;
+    println!(
+        "sparkles {} vs reference {} (pixels above {ratio}x their 3x3 median)",
+        meshlight::metrics::sparkles(&a, ratio)?,
+        meshlight::metrics::sparkles(&b, ratio)?
+    );
     if let Some(path) = diff {
         let range = plot::write_error_picture(&a, &b, &e, diff_range, path)?;
         println!(

@@ -6,6 +6,7 @@
 //! solver's to grow and the field's to keep.
 
 pub(crate) mod interpolate;
+pub(crate) mod patches;
 
 use glam::DVec3;
 

@@ -247,12 +247,16 @@ impl Shader<'_> {
         let queries =
             self.interpolator.weights(&close, &mut interpolated)? + sites_list.len() as u64;
         let mut interpolated = interpolated.into_iter();
+        // The far sites whose ray's patch spans several samples read the patch's mean.
+        let patch = self.patch_means(sites, &near_site, &footprints(spots, cast, sites))?;
         let weights: Vec<Vec<(u32, f32)>> = sites_list
             .iter()
             .zip(&near_site)
-            .map(|(site, &near)| match near {
-                true => interpolated.next().unwrap_or_default(),
-                false => self
+            .zip(&patch)
+            .map(|((site, &near), patch)| match (near, patch) {
+                (true, _) => interpolated.next().unwrap_or_default(),
+                (false, Some(_)) => Vec::new(),
+                (false, None) => self
                     .interpolator
                     .nearest(site)
                     .map_or_else(Vec::new, |k| vec![(k, 1.0)]),
@@ -260,7 +264,11 @@ impl Shader<'_> {
             .collect();
         let parts = weights
             .iter()
-            .map(|chosen| {
+            .zip(&patch)
+            .map(|(chosen, patch)| {
+                if let Some(light) = patch {
+                    return (DVec3::ZERO, *light);
+                }
                 let (mut wsum, mut direct, mut reflected) = (0.0f64, DVec3::ZERO, DVec3::ZERO);
                 for &(k, w) in chosen {
                     let w = f64::from(w);
@@ -279,6 +287,55 @@ impl Shader<'_> {
             })
             .collect();
         Ok((weights, parts, queries))
+    }
+
+    /// For each far site whose ray's patch (of radius `radius`) is wider than
+    /// [`PATCH_CELLS`] cells, the patch's mean light (`field::patches`), read in the region
+    /// of its nearest sample covered as it is, when it sees that sample (on a side something
+    /// stands on, one query each); none elsewhere.
+    fn patch_means(
+        &self,
+        sites: &Sites,
+        near_site: &[bool],
+        radius: &[f32],
+    ) -> Result<Vec<Option<DVec3>>> {
+        let mut out = vec![None; sites.sites.len()];
+        let Some(patches) = self.patches.as_ref() else {
+            return Ok(out);
+        };
+        let samples = self.interpolator.samples();
+        let mut wide = Vec::new();
+        let mut tests = Vec::new();
+        for (i, site) in sites.sites.iter().enumerate() {
+            if near_site[i] {
+                continue;
+            }
+            let Some(k) = self.interpolator.nearest(site) else {
+                continue;
+            };
+            if radius[i] <= PATCH_CELLS * patches.cell(k) {
+                continue;
+            }
+            let tested = self.field.layout.obstruction().is_obstructed(site.side);
+            if tested {
+                tests.push(Segment {
+                    a: site.point + self.lift * site.normal,
+                    b: samples.position[k as usize] + self.lift * samples.normal[k as usize],
+                });
+            }
+            wide.push((i, k, tested));
+        }
+        let mut blocked = vec![false; tests.len()];
+        self.vis.occluded(&tests, &mut blocked)?;
+        let mut answer = blocked.into_iter();
+        for (i, k, tested) in wide {
+            if tested && answer.next().unwrap_or(true) {
+                continue;
+            }
+            let site = &sites.sites[i];
+            out[i] = patches.mean(self.field, k, site.point, SQUARE * radius[i], site.covered);
+        }
+        Ok(out)
     }
 
     /// The sites within their spot's reach, as the spots of the next level, and which spot
@@ -358,6 +415,33 @@ struct Sites {
     /// Per ray: its site, if its hit is one.
     site_of: Vec<Option<usize>>,
 }
+
+/// The radius of the patch of surface each site's ray stands for: `n` stratified
+/// cosine-weighted rays each cover a projected solid angle of π/n, which at distance t and
+/// incidence θ' from a spot whose normal makes θ with the ray is a patch of area
+/// t² π / (n cos θ cos θ'), a disc of radius t / √(n cos θ cos θ'). (The cosines are bounded
+/// below: a grazing ray's patch is long and thin, not wide.)
+fn footprints(spots: &[Spot], cast: &Cast, sites: &Sites) -> Vec<f32> {
+    let mut radius = vec![0.0f32; sites.sites.len()];
+    let n = cast.per_spot as f32;
+    for (j, found) in cast.found.iter().enumerate() {
+        if let (Some(s), Some(hit)) = (sites.site_of[j], found) {
+            let dir = cast.casts[j].dir;
+            let at_spot = dir.dot(spots[j / cast.per_spot].normal).max(MIN_COSINE);
+            let at_hit = (-dir.dot(sites.sites[s].normal)).max(MIN_COSINE);
+            radius[s] = hit.t / (n * at_spot * at_hit).sqrt();
+        }
+    }
+    radius
+}
+
+/// The least cosine [`footprints`] takes.
+const MIN_COSINE: f32 = 0.25;
+/// A far site reads its patch's mean where the patch is wider than this many of the
+/// tables' cells (about a sample each); its nearest sample where it is narrower.
+const PATCH_CELLS: f32 = 2.0;
+/// Half the side of the square of a disc's area, over its radius (√π / 2).
+const SQUARE: f32 = 0.886_226_9;
 
 /// Each spot's gathered light: its rays' sites' light (direct and inter-reflected, the latter
 /// blended with what the sites gathered again), and how much of the answer comes from within

@@ -262,7 +262,7 @@ pub fn render_distributed(
             (camera.width, camera.height),
             crate::budget::BYTES_PER_PIXEL,
         )?;
-        let shader = Shader::new(scene, &solution.field, vis, options);
+        let shader = Shader::new(scene, &solution.field, vis, options)?;
         draw(scene, &shader, options, ranks, progress)
     })
 }
@@ -562,6 +562,10 @@ struct Shader<'a> {
     /// it reflects, per unit reflectance and over π (its emission is direct light, traced at
     /// the hits). Empty when nothing gathers.
     outgoing: Vec<(glam::DVec3, glam::DVec3)>,
+    /// The sum of each sample's two parts of `outgoing` over patches of its side, for the
+    /// far hits of a gather (none when nothing gathers).
+    patches: Option<crate::field::patches::PatchSums>,
+    field: &'a Field,
     /// Gather rays per pixel.
     gather_rays: u32,
     /// Direct light traced at a gather's hits near its point (none: nothing gathers).
@@ -609,7 +613,7 @@ impl<'a> Shader<'a> {
         field: &'a Field,
         vis: &'a dyn Visibility,
         options: &RenderOptions,
-    ) -> Self {
+    ) -> Result<Self> {
         let s = &field.samples;
         let light = match options.direct {
             // A solution without its samples' direct light cannot be split.
@@ -664,6 +668,11 @@ impl<'a> Shader<'a> {
         } else {
             Vec::new()
         };
+        let patches = (!outgoing.is_empty()).then(|| {
+            let sums: Vec<glam::DVec3> = outgoing.iter().map(|&(d, r)| d + r).collect();
+            crate::field::patches::PatchSums::new(field, &sums, vis, crate::visibility::lift(scene))
+        });
+        let patches = patches.transpose()?;
         let penumbra = match options.direct {
             Direct::Traced { light_samples } if light.is_some() => Some(DirectLight::reaching(
                 scene,
@@ -673,7 +682,7 @@ impl<'a> Shader<'a> {
             )),
             _ => None,
         };
-        Shader {
+        Ok(Shader {
             scene,
             vis,
             interpolator: Interpolator::new(scene, field, vis),
@@ -681,6 +690,8 @@ impl<'a> Shader<'a> {
             values,
             full,
             outgoing,
+            patches,
+            field,
             gather_rays: options.gather_rays,
             near_light: gathers.then(|| {
                 DirectLight::with_specular(scene, gather::NEAR_LIGHT_SAMPLES, field.specular_depth)
@@ -698,7 +709,7 @@ impl<'a> Shader<'a> {
             },
             lift: crate::visibility::lift(scene),
             shadow_rays: std::sync::atomic::AtomicU64::new(0),
-        }
+        })
     }
 
     /// The reflectance at a hit on a textured surface; `None` elsewhere.

@@ -1,0 +1,320 @@
+//! A value of the samples averaged over square patches of their side, any size, in constant
+//! time: per side, a summed-area table of the samples' area-weighted values over a grid of
+//! cells about a sample wide. A final-gather ray that stands for a cone of directions reads
+//! the light of the patch its cone covers at a far hit (`render::gather`); read at one point,
+//! a small bright region (the ceiling over a lamp) is a rare and large term, a sparkle.
+//!
+//! Light must not pass through a thin wall that stands on a side (a partition on a floor): on
+//! such sides the samples are split into regions, neighbours joined where they see each other,
+//! and each region has its own tables; a hit reads the region of its nearest sample, when it
+//! sees that sample.
+
+use glam::{DVec3, Vec2, Vec3};
+
+use super::Field;
+use crate::error::Result;
+use crate::sampling::surface_of;
+use crate::visibility::{Segment, Visibility};
+
+/// Samples within this many of their radii are neighbours when regions are found.
+const NEIGHBOURS: f32 = 2.5;
+/// Neighbour tests asked at once.
+const TESTS_AT_ONCE: usize = 1 << 18;
+
+/// Per region of samples, the summed-area table of a per-sample value.
+pub(crate) struct PatchSums {
+    /// Each sample's region.
+    region: Vec<u32>,
+    grids: Vec<Grid>,
+    /// The tables of the samples nothing hovers over and of those something does
+    /// (`sampling::cover`: the floor under a table), each side after side: for corner (i, j)
+    /// of a side's grid (row-major over (nx + 1) × (ny + 1) corners) the sums over the cells
+    /// below and left of it of the samples' area × value (xyz) and area (w). A point reads
+    /// the samples covered as it is: the dark floor under a table is not the light beside it.
+    sums: [Vec<[f64; 4]>; 2],
+}
+
+#[derive(Clone, Copy)]
+struct Grid {
+    first: usize,
+    nx: usize,
+    ny: usize,
+    min: Vec2,
+    cell: f32,
+}
+
+impl Grid {
+    /// The table at continuous grid coordinates (in cells from `min`), bilinear between the
+    /// corners: each cell's sums spread evenly over it.
+    fn at(&self, sums: &[[f64; 4]], p: Vec2) -> [f64; 4] {
+        let q = ((p - self.min) / self.cell)
+            .clamp(Vec2::ZERO, Vec2::new(self.nx as f32, self.ny as f32));
+        let (i, j) = (
+            (q.x as usize).min(self.nx - 1),
+            (q.y as usize).min(self.ny - 1),
+        );
+        let (fx, fy) = (f64::from(q.x) - i as f64, f64::from(q.y) - j as f64);
+        let corner = |a: usize, b: usize| sums[self.first + b * (self.nx + 1) + a];
+        let (c00, c10, c01, c11) = (
+            corner(i, j),
+            corner(i + 1, j),
+            corner(i, j + 1),
+            corner(i + 1, j + 1),
+        );
+        std::array::from_fn(|c| {
+            (1.0 - fy) * ((1.0 - fx) * c00[c] + fx * c10[c])
+                + fy * ((1.0 - fx) * c01[c] + fx * c11[c])
+        })
+    }
+}
+
+impl PatchSums {
+    /// The tables of `values` (one per sample of `field`); the regions' neighbour tests are
+    /// asked of `vis`, between points `lift` above the side.
+    pub(crate) fn new(
+        field: &Field,
+        values: &[DVec3],
+        vis: &dyn Visibility,
+        lift: f32,
+    ) -> Result<PatchSums> {
+        let s = &field.samples;
+        let region = regions(field, vis, lift)?;
+        let count = region.iter().map(|&r| r as usize + 1).max().unwrap_or(0);
+        let (mut lo, mut hi) = (vec![Vec2::MAX; count], vec![Vec2::MIN; count]);
+        let (mut members, mut radius) = (vec![0usize; count], vec![0.0f64; count]);
+        for ((&r, &uv), &d) in region.iter().zip(&s.uv).zip(&s.radius) {
+            let r = r as usize;
+            lo[r] = lo[r].min(uv);
+            hi[r] = hi[r].max(uv);
+            members[r] += 1;
+            radius[r] += f64::from(d);
+        }
+        let mut grids = Vec::with_capacity(count);
+        let mut corners = 0;
+        for r in 0..count {
+            let n = members[r].max(1);
+            // Cells about a sample's radius wide, at most about four per sample.
+            let size = (hi[r] - lo[r]).max(Vec2::splat(1e-6));
+            let sparse = (size.x * size.y / (4.0 * n as f32 + 16.0)).sqrt();
+            let cell = ((radius[r] / n as f64) as f32)
+                .max(sparse)
+                .max(size.max_element() / 4096.0);
+            let nx = ((size.x / cell).ceil() as usize).max(1);
+            let ny = ((size.y / cell).ceil() as usize).max(1);
+            grids.push(Grid {
+                first: corners,
+                nx,
+                ny,
+                min: lo[r],
+                cell,
+            });
+            corners += (nx + 1) * (ny + 1);
+        }
+        let covered = field.layout.covered();
+        let any_covered = covered.iter().any(|&c| c);
+        let mut sums = [
+            vec![[0.0f64; 4]; corners],
+            vec![[0.0f64; 4]; if any_covered { corners } else { 0 }],
+        ];
+        for k in 0..s.len() {
+            let g = grids[region[k] as usize];
+            let q = (s.uv[k] - g.min) / g.cell;
+            let (i, j) = (
+                (q.x.max(0.0) as usize).min(g.nx - 1),
+                (q.y.max(0.0) as usize).min(g.ny - 1),
+            );
+            // Into the cell's far corner; the prefix sums below carry it on.
+            let a = s.area[k];
+            let v = values[k] * a;
+            let table = &mut sums[usize::from(covered.get(k).copied().unwrap_or(false))];
+            let e = &mut table[g.first + (j + 1) * (g.nx + 1) + i + 1];
+            *e = [e[0] + v.x, e[1] + v.y, e[2] + v.z, e[3] + a];
+        }
+        for table in sums.iter_mut().filter(|t| !t.is_empty()) {
+            for g in &grids {
+                prefix_sums(g, table);
+            }
+        }
+        Ok(PatchSums {
+            region,
+            grids,
+            sums,
+        })
+    }
+
+    /// The cell width of sample k's region.
+    pub(crate) fn cell(&self, k: u32) -> f32 {
+        self.grids[self.region[k as usize] as usize].cell
+    }
+
+    /// The area-weighted mean of the value over the square of half-width `half` about the
+    /// point `point` of the region of sample `k` (its nearest, in sight of it), among the
+    /// samples covered as the point is (`covered`); none where the square holds no such
+    /// sample's area.
+    pub(crate) fn mean(
+        &self,
+        field: &Field,
+        k: u32,
+        point: Vec3,
+        half: f32,
+        covered: bool,
+    ) -> Option<DVec3> {
+        let g = self.grids[self.region[k as usize] as usize];
+        let side = field.samples.side[k as usize];
+        let sums = &self.sums[usize::from(covered)];
+        if sums.is_empty() {
+            return None;
+        }
+        let uv = field.layout.maps()[surface_of(side) as usize].to_2d(point);
+        let d = Vec2::splat(half);
+        let (a, b) = (uv - d, uv + d);
+        let s11 = g.at(sums, b);
+        let s00 = g.at(sums, a);
+        let s10 = g.at(sums, Vec2::new(b.x, a.y));
+        let s01 = g.at(sums, Vec2::new(a.x, b.y));
+        let box_sum: [f64; 4] = std::array::from_fn(|c| s11[c] - s10[c] - s01[c] + s00[c]);
+        // Rounding leaves crumbs where the square misses every sample.
+        (box_sum[3] > 1e-9 * s11[3].abs().max(1e-30))
+            .then(|| DVec3::new(box_sum[0], box_sum[1], box_sum[2]) / box_sum[3])
+    }
+}
+
+/// Each sample's region: on a side nothing stands on, the side's samples; on one something
+/// stands on, the samples joined by chains of neighbours (within [`NEIGHBOURS`] radii) that
+/// see each other along the side, so a wall standing on the side parts its two rooms.
+fn regions(field: &Field, vis: &dyn Visibility, lift: f32) -> Result<Vec<u32>> {
+    let s = &field.samples;
+    let layout = &field.layout;
+    let mut parent: Vec<u32> = (0..s.len() as u32).collect();
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let mut near = Vec::new();
+    let mut first_of = vec![u32::MAX; 2 * layout.maps().len()];
+    for k in 0..s.len() {
+        let side = s.side[k];
+        if layout.obstruction().is_obstructed(side) {
+            let reach = NEIGHBOURS * s.radius[k];
+            layout.index().within(s, side, s.uv[k], reach, &mut near);
+            pairs.extend(
+                near.iter()
+                    .filter(|&&(j, _)| j as usize > k)
+                    .map(|&(j, _)| (k as u32, j)),
+            );
+        } else if first_of[side as usize] == u32::MAX {
+            first_of[side as usize] = k as u32;
+        } else {
+            pairs.push((first_of[side as usize], k as u32));
+        }
+    }
+    let lifted = |k: u32| s.position[k as usize] + lift * s.normal[k as usize];
+    for chunk in pairs.chunks(TESTS_AT_ONCE) {
+        let segments: Vec<Segment> = chunk
+            .iter()
+            .map(|&(a, b)| Segment {
+                a: lifted(a),
+                b: lifted(b),
+            })
+            .collect();
+        let mut blocked = vec![false; segments.len()];
+        // Sides nothing stands on join without a test.
+        let tested: Vec<usize> = (0..chunk.len())
+            .filter(|&i| {
+                layout
+                    .obstruction()
+                    .is_obstructed(s.side[chunk[i].0 as usize])
+            })
+            .collect();
+        let asked: Vec<Segment> = tested.iter().map(|&i| segments[i]).collect();
+        let mut answers = vec![false; asked.len()];
+        vis.occluded(&asked, &mut answers)?;
+        for (&i, &b) in tested.iter().zip(&answers) {
+            blocked[i] = b;
+        }
+        for (&(a, b), &blocked) in chunk.iter().zip(&blocked) {
+            if !blocked {
+                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                // The smaller index roots: the labels do not depend on the order of joins.
+                let (lo, hi) = (ra.min(rb), ra.max(rb));
+                parent[hi as usize] = lo;
+            }
+        }
+    }
+    // Roots numbered in sample order.
+    let mut label = vec![u32::MAX; s.len()];
+    let mut next = 0u32;
+    let mut region = vec![0u32; s.len()];
+    for k in 0..s.len() as u32 {
+        let r = root(&mut parent, k) as usize;
+        if label[r] == u32::MAX {
+            label[r] = next;
+            next += 1;
+        }
+        region[k as usize] = label[r];
+    }
+    Ok(region)
+}
+
+/// The root of k's set, halving the path on the way.
+fn root(parent: &mut [u32], mut k: u32) -> u32 {
+    while parent[k as usize] != k {
+        let up = parent[parent[k as usize] as usize];
+        parent[k as usize] = up;
+        k = up;
+    }
+    k
+}
+
+/// Turns a region's deposits (each cell's sums at its far corner) into its summed-area table.
+fn prefix_sums(g: &Grid, table: &mut [[f64; 4]]) {
+    let row = g.nx + 1;
+    for j in 1..=g.ny {
+        for i in 1..=g.nx {
+            let at = g.first + j * row + i;
+            let (left, below, diagonal) = (table[at - 1], table[at - row], table[at - row - 1]);
+            for c in 0..4 {
+                table[at][c] += left[c] + below[c] - diagonal[c];
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_box_reads_the_area_weighted_mean_of_the_samples_it_holds_whole() {
+        // Two samples in separate cells of a unit grid: a box holding one cell whole reads its
+        // sample's value; a box holding both their area-weighted mean; one holding none, none.
+        let g = Grid {
+            first: 0,
+            nx: 4,
+            ny: 1,
+            min: Vec2::ZERO,
+            cell: 1.0,
+        };
+        // Sample of area 1, value 2 in cell 0; area 3, value 6 in cell 2.
+        let mut sums = vec![[0.0f64; 4]; 5 * 2];
+        sums[5 + 1] = [2.0, 2.0, 2.0, 1.0];
+        sums[5 + 3] = [18.0, 18.0, 18.0, 3.0];
+        for i in 1..5 {
+            let before = sums[5 + i - 1];
+            for (v, b) in sums[5 + i].iter_mut().zip(before) {
+                *v += b;
+            }
+        }
+        let mean = |a: Vec2, b: Vec2| {
+            let (s11, s00) = (g.at(&sums, b), g.at(&sums, a));
+            let (s10, s01) = (
+                g.at(&sums, Vec2::new(b.x, a.y)),
+                g.at(&sums, Vec2::new(a.x, b.y)),
+            );
+            let w = s11[3] - s10[3] - s01[3] + s00[3];
+            ((s11[0] - s10[0] - s01[0] + s00[0]) / w, w)
+        };
+        assert!((mean(Vec2::new(0.0, 0.0), Vec2::new(1.0, 1.0)).0 - 2.0).abs() < 1e-12);
+        assert!((mean(Vec2::new(0.0, 0.0), Vec2::new(4.0, 1.0)).0 - 5.0).abs() < 1e-12);
+        // Half of cell 2 holds half of its sample's area.
+        assert!((mean(Vec2::new(2.5, 0.0), Vec2::new(4.0, 1.0)).1 - 1.5).abs() < 1e-12);
+        assert!(mean(Vec2::new(3.0, 0.0), Vec2::new(4.0, 1.0)).1.abs() < 1e-12);
+    }
+}
