@@ -231,10 +231,20 @@ fn trapped(scene: &Scene, s: u32, hits: &[Option<Hit>], met: usize) -> Option<Fi
     let mut distances: Vec<f32> = hits.iter().flatten().map(|h| h.t).collect();
     distances.sort_by(f32::total_cmp);
     let median = distances[distances.len() / 2];
+    let material = &scene.materials()[scene.surfaces()[s as usize].material as usize];
+    let advice = if material.two_sided {
+        "its material is two_sided, so this is one of its two faces: the light that face \
+         emits stays in the gap, as it would in Cycles. Make the material one-sided (two_sided \
+         = false) if the panel is meant to light the room only"
+    } else {
+        "a light panel facing the ceiling? Blender's lights emit from both sides. Flip its \
+         normals, or set two_sided = true on its material"
+    };
     (median < CLOSE * scene.bounds().diagonal()).then(|| Finding {
         fatal: false,
         message: format!(
-            "the area light {} faces a surface {median:.3} away over most of its                              front: its light is trapped there (a light panel facing the                              ceiling? Blender's lights emit from both sides). Flip its normals,                              or set two_sided = true on its material.",
+            "the area light {} faces a surface {median:.3} away over most of its front: its \
+             light is trapped there ({advice}).",
             surface_name(scene, s)
         ),
     })

@@ -83,6 +83,20 @@ fn a_panel_facing_the_ceiling_from_a_centimetre_away_is_trapped() {
 }
 
 #[test]
+fn a_two_sided_panel_under_the_ceiling_is_told_its_upper_face_is_trapped_not_to_turn_two_sided() {
+    // Blender's mesh lights (glTF doubleSided): the face towards the ceiling is trapped, and
+    // the advice is not the one for a one-sided panel (it is two-sided already).
+    let mut b = room(|b, lamp| facing_down(b, 2.99, [1.5, 2.5], [1.5, 2.5], lamp));
+    b.mesh.materials[1].two_sided = true;
+    let found = findings(&b.scene(inside()));
+    assert!(says(&found, "faces a surface 0.01"), "{found:?}");
+    assert!(says(&found, "two_sided = false"), "{found:?}");
+    assert!(!says(&found, "set two_sided = true"), "{found:?}");
+    // One line of prose, without the source's indentation in it.
+    assert!(found.iter().all(|f| !f.message.contains("  ")), "{found:?}");
+}
+
+#[test]
 fn a_light_facing_the_open_sky_sees_nothing() {
     // A floor and, above it, a panel facing up: its front sees nothing at all.
     let mut b = Builder::default();

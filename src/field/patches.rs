@@ -26,12 +26,14 @@ pub(crate) struct PatchSums {
     /// Each sample's region.
     region: Vec<u32>,
     grids: Vec<Grid>,
-    /// The tables of the samples nothing hovers over and of those something does
-    /// (`sampling::cover`: the floor under a table), each side after side: for corner (i, j)
-    /// of a side's grid (row-major over (nx + 1) × (ny + 1) corners) the sums over the cells
-    /// below and left of it of the samples' area × value (xyz) and area (w). A point reads
-    /// the samples covered as it is: the dark floor under a table is not the light beside it.
-    sums: [Vec<[f64; 4]>; 2],
+    /// The tables of the samples nothing hovers over, region after region: for corner (i, j)
+    /// of a region's grid (row-major over (nx + 1) × (ny + 1) corners) the sums over the
+    /// cells below and left of it of the samples' area × value (xyz) and area (w). Samples
+    /// under a cover (`sampling::cover`: the ceiling over a panel 1 cm under it) are left out:
+    /// a cone wide enough to read a patch is far wider than the slit between the cover and
+    /// the side, and meets the cover, not what lies under it (read in full, the ceiling lit
+    /// in the slit was a sparkle along every wall–ceiling edge).
+    sums: Vec<[f64; 4]>,
 }
 
 #[derive(Clone, Copy)]
@@ -111,12 +113,11 @@ impl PatchSums {
             corners += (nx + 1) * (ny + 1);
         }
         let covered = field.layout.covered();
-        let any_covered = covered.iter().any(|&c| c);
-        let mut sums = [
-            vec![[0.0f64; 4]; corners],
-            vec![[0.0f64; 4]; if any_covered { corners } else { 0 }],
-        ];
+        let mut sums = vec![[0.0f64; 4]; corners];
         for k in 0..s.len() {
+            if covered.get(k).copied().unwrap_or(false) {
+                continue;
+            }
             let g = grids[region[k] as usize];
             let q = (s.uv[k] - g.min) / g.cell;
             let (i, j) = (
@@ -126,14 +127,11 @@ impl PatchSums {
             // Into the cell's far corner; the prefix sums below carry it on.
             let a = s.area[k];
             let v = values[k] * a;
-            let table = &mut sums[usize::from(covered.get(k).copied().unwrap_or(false))];
-            let e = &mut table[g.first + (j + 1) * (g.nx + 1) + i + 1];
+            let e = &mut sums[g.first + (j + 1) * (g.nx + 1) + i + 1];
             *e = [e[0] + v.x, e[1] + v.y, e[2] + v.z, e[3] + a];
         }
-        for table in sums.iter_mut().filter(|t| !t.is_empty()) {
-            for g in &grids {
-                prefix_sums(g, table);
-            }
+        for g in &grids {
+            prefix_sums(g, &mut sums);
         }
         Ok(PatchSums {
             region,
@@ -149,22 +147,11 @@ impl PatchSums {
 
     /// The area-weighted mean of the value over the square of half-width `half` about the
     /// point `point` of the region of sample `k` (its nearest, in sight of it), among the
-    /// samples covered as the point is (`covered`); none where the square holds no such
-    /// sample's area.
-    pub(crate) fn mean(
-        &self,
-        field: &Field,
-        k: u32,
-        point: Vec3,
-        half: f32,
-        covered: bool,
-    ) -> Option<DVec3> {
+    /// samples nothing covers; none where the square holds no such sample's area.
+    pub(crate) fn mean(&self, field: &Field, k: u32, point: Vec3, half: f32) -> Option<DVec3> {
         let g = self.grids[self.region[k as usize] as usize];
         let side = field.samples.side[k as usize];
-        let sums = &self.sums[usize::from(covered)];
-        if sums.is_empty() {
-            return None;
-        }
+        let sums = &self.sums;
         let uv = field.layout.maps()[surface_of(side) as usize].to_2d(point);
         let d = Vec2::splat(half);
         let (a, b) = (uv - d, uv + d);

@@ -333,7 +333,7 @@ impl Shader<'_> {
                 continue;
             }
             let site = &sites.sites[i];
-            out[i] = patches.mean(self.field, k, site.point, SQUARE * radius[i], site.covered);
+            out[i] = patches.mean(self.field, k, site.point, SQUARE * radius[i]);
         }
         Ok(out)
     }
