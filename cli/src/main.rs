@@ -400,6 +400,18 @@ fn compare(
 ) -> anyhow::Result<()> {
     let a = Image::read_exr(image)?;
     let b = Image::read_exr(reference)?;
+    if (a.width, a.height) != (b.width, b.height) {
+        anyhow::bail!(
+            "{} is {}x{} but {} is {}x{}: compare images of one size (render the image at \
+             the reference's with --width/--height)",
+            image.display(),
+            a.width,
+            a.height,
+            reference.display(),
+            b.width,
+            b.height
+        );
+    }
     let e = meshlight::metrics::compare_blocks(&a, &b, block)?;
     println!("MAE/mean {:.5}", e.mae_over_mean);
     println!("bias {:+.5} (mean difference / reference mean)", e.bias);

@@ -256,6 +256,8 @@ fn compare_reports_bias_and_draws_the_signed_error() {
     let stdout = text(&run.stdout);
     assert!(stdout.contains("MAE/mean 0.12500"), "{stdout}");
     assert!(stdout.contains("bias +0.12500"), "{stdout}");
+    // Two pixels in a row: none has a whole 3 × 3 neighbourhood.
+    assert!(stdout.contains("sparkles 0 vs reference 0"), "{stdout}");
     // The 99th percentile of |error| is 0.25, rounded up to 0.5: the bright pixel sits
     // halfway up the red side (the light-red stop), the exact one is white.
     assert!(stdout.contains("saturate at ±50.000%"), "{stdout}");
@@ -284,9 +286,10 @@ fn compare_refuses_images_of_different_sizes() {
     assert!(!run.status.success());
     let stderr = text(&run.stderr);
     assert!(
-        stderr.contains("image sizes differ: 1x1 vs 2x1"),
+        stderr.contains(" is 1x1 but ") && stderr.contains(" is 2x1: compare images of one size"),
         "{stderr}"
     );
+    assert!(!stderr.contains("invalid option"), "{stderr}");
 }
 
 #[test]
