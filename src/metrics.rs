@@ -183,7 +183,7 @@ fn same_size(image: &Image, reference: &Image) -> Result<()> {
 mod tests {
     use super::*;
 
-    fn field_of(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> Image {
+    fn image_of(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> Image {
         let pixels = (0..height)
             .flat_map(|y| (0..width).map(move |x| (x, y)))
             .map(|(x, y)| Vec3::splat(f(x, y)))
@@ -200,14 +200,14 @@ mod tests {
         // One pixel at 1.5 on a field of 1 stands above its neighbourhood's median (1); a
         // band three pixels wide at 2 does not: its middle's 3 × 3 median is 2, and its edges'
         // is 2 as well (six of nine in the band).
-        let lone = field_of(8, 8, |x, y| if (x, y) == (4, 3) { 1.5 } else { 1.0 });
+        let lone = image_of(8, 8, |x, y| if (x, y) == (4, 3) { 1.5 } else { 1.0 });
         assert_eq!(sparkles(&lone, SPARKLE_RATIO).unwrap(), 1);
-        let just_under = field_of(8, 8, |x, y| if (x, y) == (4, 3) { 1.29 } else { 1.0 });
+        let just_under = image_of(8, 8, |x, y| if (x, y) == (4, 3) { 1.29 } else { 1.0 });
         assert_eq!(sparkles(&just_under, SPARKLE_RATIO).unwrap(), 0);
-        let band = field_of(8, 8, |x, _| if (3..6).contains(&x) { 2.0 } else { 1.0 });
+        let band = image_of(8, 8, |x, _| if (3..6).contains(&x) { 2.0 } else { 1.0 });
         assert_eq!(sparkles(&band, SPARKLE_RATIO).unwrap(), 0);
         // On the border a pixel has no full neighbourhood: not counted.
-        let edge = field_of(8, 8, |x, y| if (x, y) == (0, 3) { 5.0 } else { 1.0 });
+        let edge = image_of(8, 8, |x, y| if (x, y) == (0, 3) { 5.0 } else { 1.0 });
         assert_eq!(sparkles(&edge, SPARKLE_RATIO).unwrap(), 0);
     }
 

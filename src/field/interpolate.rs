@@ -75,6 +75,11 @@ impl<'a> Interpolator<'a> {
         self
     }
 
+    /// The field read.
+    pub(crate) fn field(&self) -> &Field {
+        self.field
+    }
+
     /// The samples interpolated.
     pub(crate) fn samples(&self) -> &crate::sampling::Samples {
         &self.field.samples

@@ -68,19 +68,28 @@ impl Grid {
                 + fy * ((1.0 - fx) * c01[c] + fx * c11[c])
         })
     }
+
+    /// The sums over the rectangle from `a` to `b`, and the area weight of the whole table up
+    /// to `b` (the scale of its rounding).
+    fn box_sum(&self, sums: &[[f64; 4]], a: Vec2, b: Vec2) -> ([f64; 4], f64) {
+        let (s11, s00) = (self.at(sums, b), self.at(sums, a));
+        let (s10, s01) = (
+            self.at(sums, Vec2::new(b.x, a.y)),
+            self.at(sums, Vec2::new(a.x, b.y)),
+        );
+        (
+            std::array::from_fn(|c| s11[c] - s10[c] - s01[c] + s00[c]),
+            s11[3].abs(),
+        )
+    }
 }
 
 impl PatchSums {
     /// The tables of `values` (one per sample of `field`); the regions' neighbour tests are
-    /// asked of `vis`, between points `lift` above the side.
-    pub(crate) fn new(
-        field: &Field,
-        values: &[DVec3],
-        vis: &dyn Visibility,
-        lift: f32,
-    ) -> Result<PatchSums> {
+    /// asked of `vis`.
+    pub(crate) fn new(field: &Field, values: &[DVec3], vis: &dyn Visibility) -> Result<PatchSums> {
         let s = &field.samples;
-        let region = regions(field, vis, lift)?;
+        let region = regions(field, vis)?;
         let count = region.iter().map(|&r| r as usize + 1).max().unwrap_or(0);
         let (mut lo, mut hi) = (vec![Vec2::MAX; count], vec![Vec2::MIN; count]);
         let (mut members, mut radius) = (vec![0usize; count], vec![0.0f64; count]);
@@ -151,77 +160,48 @@ impl PatchSums {
     pub(crate) fn mean(&self, field: &Field, k: u32, point: Vec3, half: f32) -> Option<DVec3> {
         let g = self.grids[self.region[k as usize] as usize];
         let side = field.samples.side[k as usize];
-        let sums = &self.sums;
+        let sums = &self.sums[..];
         let uv = field.layout.maps()[surface_of(side) as usize].to_2d(point);
         let d = Vec2::splat(half);
-        let (a, b) = (uv - d, uv + d);
-        let s11 = g.at(sums, b);
-        let s00 = g.at(sums, a);
-        let s10 = g.at(sums, Vec2::new(b.x, a.y));
-        let s01 = g.at(sums, Vec2::new(a.x, b.y));
-        let box_sum: [f64; 4] = std::array::from_fn(|c| s11[c] - s10[c] - s01[c] + s00[c]);
+        let (sum, total) = g.box_sum(sums, uv - d, uv + d);
         // Rounding leaves crumbs where the square misses every sample.
-        (box_sum[3] > 1e-9 * s11[3].abs().max(1e-30))
-            .then(|| DVec3::new(box_sum[0], box_sum[1], box_sum[2]) / box_sum[3])
+        (sum[3] > 1e-9 * total.max(1e-30)).then(|| DVec3::new(sum[0], sum[1], sum[2]) / sum[3])
     }
 }
 
 /// Each sample's region: on a side nothing stands on, the side's samples; on one something
 /// stands on, the samples joined by chains of neighbours (within [`NEIGHBOURS`] radii) that
 /// see each other along the side, so a wall standing on the side parts its two rooms.
-fn regions(field: &Field, vis: &dyn Visibility, lift: f32) -> Result<Vec<u32>> {
+fn regions(field: &Field, vis: &dyn Visibility) -> Result<Vec<u32>> {
     let s = &field.samples;
-    let layout = &field.layout;
+    let (index, obstruction) = (field.layout.index(), field.layout.obstruction());
     let mut parent: Vec<u32> = (0..s.len() as u32).collect();
     let mut pairs: Vec<(u32, u32)> = Vec::new();
     let mut near = Vec::new();
-    let mut first_of = vec![u32::MAX; 2 * layout.maps().len()];
-    for k in 0..s.len() {
-        let side = s.side[k];
-        if layout.obstruction().is_obstructed(side) {
-            let reach = NEIGHBOURS * s.radius[k];
-            layout.index().within(s, side, s.uv[k], reach, &mut near);
-            pairs.extend(
-                near.iter()
-                    .filter(|&&(j, _)| j as usize > k)
-                    .map(|&(j, _)| (k as u32, j)),
-            );
+    let mut first_of = vec![u32::MAX; 2 * field.layout.maps().len()];
+    for k in 0..s.len() as u32 {
+        let side = s.side[k as usize];
+        if obstruction.is_obstructed(side) {
+            let reach = NEIGHBOURS * s.radius[k as usize];
+            index.within(s, side, s.uv[k as usize], reach, &mut near);
+            pairs.extend(near.iter().filter(|&&(j, _)| j > k).map(|&(j, _)| (k, j)));
         } else if first_of[side as usize] == u32::MAX {
-            first_of[side as usize] = k as u32;
+            first_of[side as usize] = k;
         } else {
-            pairs.push((first_of[side as usize], k as u32));
+            // Nothing stands on the side: all of it is one region, without a test.
+            join(&mut parent, first_of[side as usize], k);
         }
     }
-    let lifted = |k: u32| s.position[k as usize] + lift * s.normal[k as usize];
     for chunk in pairs.chunks(TESTS_AT_ONCE) {
         let segments: Vec<Segment> = chunk
             .iter()
-            .map(|&(a, b)| Segment {
-                a: lifted(a),
-                b: lifted(b),
-            })
+            .map(|&(a, b)| obstruction.segment(s.normal[a as usize], s.position[a as usize], s, b))
             .collect();
         let mut blocked = vec![false; segments.len()];
-        // Sides nothing stands on join without a test.
-        let tested: Vec<usize> = (0..chunk.len())
-            .filter(|&i| {
-                layout
-                    .obstruction()
-                    .is_obstructed(s.side[chunk[i].0 as usize])
-            })
-            .collect();
-        let asked: Vec<Segment> = tested.iter().map(|&i| segments[i]).collect();
-        let mut answers = vec![false; asked.len()];
-        vis.occluded(&asked, &mut answers)?;
-        for (&i, &b) in tested.iter().zip(&answers) {
-            blocked[i] = b;
-        }
+        vis.occluded(&segments, &mut blocked)?;
         for (&(a, b), &blocked) in chunk.iter().zip(&blocked) {
             if !blocked {
-                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-                // The smaller index roots: the labels do not depend on the order of joins.
-                let (lo, hi) = (ra.min(rb), ra.max(rb));
-                parent[hi as usize] = lo;
+                join(&mut parent, a, b);
             }
         }
     }
@@ -238,6 +218,13 @@ fn regions(field: &Field, vis: &dyn Visibility, lift: f32) -> Result<Vec<u32>> {
         region[k as usize] = label[r];
     }
     Ok(region)
+}
+
+/// Joins the sets of a and b; the smaller root roots both, so the labels do not depend on the
+/// order of joins.
+fn join(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (root(parent, a), root(parent, b));
+    parent[ra.max(rb) as usize] = ra.min(rb);
 }
 
 /// The root of k's set, halving the path on the way.
@@ -279,24 +266,15 @@ mod tests {
             min: Vec2::ZERO,
             cell: 1.0,
         };
-        // Sample of area 1, value 2 in cell 0; area 3, value 6 in cell 2.
+        // Sample of area 1, value 2 in cell 0; area 3, value 6 in cell 2, deposited at their
+        // cells' far corners as `new` does.
         let mut sums = vec![[0.0f64; 4]; 5 * 2];
         sums[5 + 1] = [2.0, 2.0, 2.0, 1.0];
         sums[5 + 3] = [18.0, 18.0, 18.0, 3.0];
-        for i in 1..5 {
-            let before = sums[5 + i - 1];
-            for (v, b) in sums[5 + i].iter_mut().zip(before) {
-                *v += b;
-            }
-        }
+        prefix_sums(&g, &mut sums);
         let mean = |a: Vec2, b: Vec2| {
-            let (s11, s00) = (g.at(&sums, b), g.at(&sums, a));
-            let (s10, s01) = (
-                g.at(&sums, Vec2::new(b.x, a.y)),
-                g.at(&sums, Vec2::new(a.x, b.y)),
-            );
-            let w = s11[3] - s10[3] - s01[3] + s00[3];
-            ((s11[0] - s10[0] - s01[0] + s00[0]) / w, w)
+            let (sum, _) = g.box_sum(&sums, a, b);
+            (sum[0] / sum[3], sum[3])
         };
         assert!((mean(Vec2::new(0.0, 0.0), Vec2::new(1.0, 1.0)).0 - 2.0).abs() < 1e-12);
         assert!((mean(Vec2::new(0.0, 0.0), Vec2::new(4.0, 1.0)).0 - 5.0).abs() < 1e-12);

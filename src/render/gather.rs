@@ -247,19 +247,28 @@ impl Shader<'_> {
         let queries =
             self.interpolator.weights(&close, &mut interpolated)? + sites_list.len() as u64;
         let mut interpolated = interpolated.into_iter();
-        // The far sites whose ray's patch spans several samples read the patch's mean.
-        let patch = self.patch_means(sites, &near_site, &footprints(spots, cast, sites))?;
-        let weights: Vec<Vec<(u32, f32)>> = sites_list
+        // The far sites read their nearest sample, or where their ray's patch spans several
+        // samples the patch's mean.
+        let nearest: Vec<Option<u32>> = sites_list
             .iter()
             .zip(&near_site)
+            .map(|(site, &near)| {
+                if near {
+                    None
+                } else {
+                    self.interpolator.nearest(site)
+                }
+            })
+            .collect();
+        let patch = self.patch_means(sites, &nearest, &footprints(spots, cast, sites))?;
+        let weights: Vec<Vec<(u32, f32)>> = near_site
+            .iter()
+            .zip(&nearest)
             .zip(&patch)
-            .map(|((site, &near), patch)| match (near, patch) {
+            .map(|((&near, nearest), patch)| match (near, patch) {
                 (true, _) => interpolated.next().unwrap_or_default(),
                 (false, Some(_)) => Vec::new(),
-                (false, None) => self
-                    .interpolator
-                    .nearest(site)
-                    .map_or_else(Vec::new, |k| vec![(k, 1.0)]),
+                (false, None) => nearest.map_or_else(Vec::new, |k| vec![(k, 1.0)]),
             })
             .collect();
         let parts = weights
@@ -289,39 +298,34 @@ impl Shader<'_> {
         Ok((weights, parts, queries))
     }
 
-    /// For each far site whose ray's patch (of radius `radius`) is wider than
-    /// [`PATCH_CELLS`] cells, the patch's mean light (`field::patches`), read in the region
-    /// of its nearest sample covered as it is, when it sees that sample (on a side something
-    /// stands on, one query each); none elsewhere.
+    /// For each far site (with its nearest sample, covered as it is) whose ray's patch (of
+    /// radius `radius`) is wider than [`PATCH_CELLS`] cells, the patch's mean light
+    /// (`field::patches`), read in the region of that sample when the site sees it (on a side
+    /// something stands on, one query each); none elsewhere.
     fn patch_means(
         &self,
         sites: &Sites,
-        near_site: &[bool],
+        nearest: &[Option<u32>],
         radius: &[f32],
     ) -> Result<Vec<Option<DVec3>>> {
         let mut out = vec![None; sites.sites.len()];
         let Some(patches) = self.patches.as_ref() else {
             return Ok(out);
         };
-        let samples = self.interpolator.samples();
+        let field = self.interpolator.field();
+        let obstruction = field.layout.obstruction();
         let mut wide = Vec::new();
         let mut tests = Vec::new();
         for (i, site) in sites.sites.iter().enumerate() {
-            if near_site[i] {
-                continue;
-            }
-            let Some(k) = self.interpolator.nearest(site) else {
+            let Some(k) = nearest[i] else {
                 continue;
             };
             if radius[i] <= PATCH_CELLS * patches.cell(k) {
                 continue;
             }
-            let tested = self.field.layout.obstruction().is_obstructed(site.side);
+            let tested = obstruction.is_obstructed(site.side);
             if tested {
-                tests.push(Segment {
-                    a: site.point + self.lift * site.normal,
-                    b: samples.position[k as usize] + self.lift * samples.normal[k as usize],
-                });
+                tests.push(obstruction.segment(site.normal, site.point, &field.samples, k));
             }
             wide.push((i, k, tested));
         }
@@ -333,7 +337,7 @@ impl Shader<'_> {
                 continue;
             }
             let site = &sites.sites[i];
-            out[i] = patches.mean(self.field, k, site.point, SQUARE * radius[i]);
+            out[i] = patches.mean(field, k, site.point, SQUARE * radius[i]);
         }
         Ok(out)
     }

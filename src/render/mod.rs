@@ -568,7 +568,6 @@ struct Shader<'a> {
     /// The sum of each sample's two parts of `outgoing` over patches of its side, for the
     /// far hits of a gather (none when nothing gathers).
     patches: Option<crate::field::patches::PatchSums>,
-    field: &'a Field,
     /// Gather rays per pixel.
     gather_rays: u32,
     /// Direct light traced at a gather's hits near its point (none: nothing gathers).
@@ -673,7 +672,7 @@ impl<'a> Shader<'a> {
         };
         let patches = (!outgoing.is_empty()).then(|| {
             let sums: Vec<glam::DVec3> = outgoing.iter().map(|&(d, r)| d + r).collect();
-            crate::field::patches::PatchSums::new(field, &sums, vis, crate::visibility::lift(scene))
+            crate::field::patches::PatchSums::new(field, &sums, vis)
         });
         let patches = patches.transpose()?;
         let penumbra = match options.direct {
@@ -694,7 +693,6 @@ impl<'a> Shader<'a> {
             full,
             outgoing,
             patches,
-            field,
             gather_rays: options.gather_rays,
             near_light: gathers.then(|| {
                 DirectLight::with_specular(scene, gather::NEAR_LIGHT_SAMPLES, field.specular_depth)
