@@ -67,8 +67,10 @@ fn furnace_is_ke_over_one_minus_kd_everywhere() {
     }
 }
 
-#[test]
-fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
+/// A grey plane 40 m square lit by a point light of intensity 7 at `light`, seen from `eye`
+/// towards `look_at` (24 × 24 pixels), and each pixel's analytic radiance averaged over the pixel (box filter)
+/// on a 16 × 16 grid: Kd/π · I · cosθ / r² where the ray lands.
+fn point_light_over_a_plane(light: Vec3, eye: Vec3, look_at: Vec3) -> (Scene, Vec<f64>) {
     let mut builder = Builder::default();
     let grey = builder.material(material("grey", 0.5, 0.0));
     builder.quad(
@@ -80,15 +82,12 @@ fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
         ],
         grey,
     );
-    let light = Vec3::new(0.3, 1.5, -0.2);
     let intensity = 7.0;
     builder.point_lights.push(PointLight {
         position: light,
         intensity: Vec3::splat(intensity),
     });
-    let scene = builder.scene(camera(Vec3::new(0.0, 3.0, 2.5), Vec3::ZERO, 24));
-    // The analytic answer, averaged over each pixel (box filter) on a 16 × 16 grid: the radiance
-    // of the plane where the ray lands, Kd/π · I · cosθ / r².
+    let scene = builder.scene(camera(eye, look_at, 24));
     let c = &scene.camera();
     let radiance = |x: f32, y: f32| -> f64 {
         let d = c.direction(x, y).as_dvec3();
@@ -104,6 +103,30 @@ fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
         0.5 / std::f64::consts::PI * f64::from(intensity) * (to.y / to.length())
             / to.length_squared()
     };
+    let expected = (0..24 * 24)
+        .map(|i| {
+            let (px, py) = ((i % 24) as f32, (i / 24) as f32);
+            (0..16 * 16)
+                .map(|k| {
+                    radiance(
+                        px + ((k % 16) as f32 + 0.5) / 16.0,
+                        py + ((k / 16) as f32 + 0.5) / 16.0,
+                    )
+                })
+                .sum::<f64>()
+                / 256.0
+        })
+        .collect();
+    (scene, expected)
+}
+
+#[test]
+fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
+    let (scene, expected) = point_light_over_a_plane(
+        Vec3::new(0.3, 1.5, -0.2),
+        Vec3::new(0.0, 3.0, 2.5),
+        Vec3::ZERO,
+    );
     for backend in backends() {
         let traced = trace(
             &scene,
@@ -113,23 +136,52 @@ fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
                 ..PathOptions::default()
             },
         );
-        for (i, p) in traced.image.pixels.iter().enumerate() {
-            let (px, py) = ((i % 24) as f32, (i / 24) as f32);
-            let expected: f64 = (0..16 * 16)
-                .map(|k| {
-                    radiance(
-                        px + ((k % 16) as f32 + 0.5) / 16.0,
-                        py + ((k / 16) as f32 + 0.5) / 16.0,
-                    )
-                })
-                .sum::<f64>()
-                / 256.0;
+        for (i, (p, &expected)) in traced.image.pixels.iter().zip(&expected).enumerate() {
             let got = f64::from(p.x);
             assert!(
                 (got - expected).abs() <= 0.01 * expected + 1e-9,
                 "{backend}: pixel {i}: {got} vs {expected}"
             );
         }
+    }
+}
+
+#[test]
+fn a_point_light_just_over_a_plane_is_measured_from_the_plane_not_from_the_lifted_point() {
+    // 0.15 m over a plane 40 m across: the shadow rays leave 5.7 mm above the plane (10⁻⁴ of
+    // the scene's diagonal), and measured from there the pool under the light read 2 × 5.7 /
+    // 150 = 7.6% too bright at its centre (+5.3% over the 3 × 3 pixels below).
+    let (scene, expected) = point_light_over_a_plane(
+        Vec3::new(0.3, 0.15, -0.2),
+        Vec3::new(0.3, 1.0, 0.6),
+        Vec3::new(0.3, 0.0, -0.2),
+    );
+    // The pool: the 3 × 3 pixels about the brightest (a pixel is about 6 cm on the plane;
+    // further out the lifted point reads the light too dim, and over the whole plane the
+    // lift changes nothing).
+    let peak = (0..expected.len())
+        .max_by(|&a, &b| expected[a].total_cmp(&expected[b]))
+        .unwrap();
+    let pool: Vec<usize> = (0..expected.len())
+        .filter(|&i| (i % 24).abs_diff(peak % 24) <= 1 && (i / 24).abs_diff(peak / 24) <= 1)
+        .collect();
+    let sum = |values: &dyn Fn(usize) -> f64| pool.iter().map(|&i| values(i)).sum::<f64>();
+    let exact = sum(&|i| expected[i]);
+    for backend in backends() {
+        let traced = trace(
+            &scene,
+            backend,
+            PathOptions {
+                spp: 256,
+                ..PathOptions::default()
+            },
+        );
+        let got = sum(&|i| f64::from(traced.image.pixels[i].x));
+        assert!(
+            (got / exact - 1.0).abs() < 0.01,
+            "{backend}: the pool's sum {got} against {exact} ({:+.2}%)",
+            100.0 * (got / exact - 1.0)
+        );
     }
 }
 

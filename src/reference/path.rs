@@ -632,7 +632,7 @@ impl Tracer<'_> {
             p_diffuse: 1.0,
             p_lobe: 0.0,
         };
-        self.next_events(index, path, from, &smooth, queue);
+        self.next_events(index, path, (x, from), &smooth, queue);
 
         // The next bounce: cosine-weighted about the normal, then Russian roulette.
         path.bounces += 1;
@@ -652,19 +652,23 @@ impl Tracer<'_> {
     /// Light sampling at a vertex with a non-delta part: every point light and luminaire, one
     /// point on an emitter (with the weight of multiple importance sampling against drawing
     /// the direction from `smooth`), and both again through each chain of planar mirrors.
-    /// Draws three numbers from the path's generator.
+    /// Draws three numbers from the path's generator. `at` is the vertex and the point its
+    /// shadow rays leave from, lifted off the surface: distances and angles are measured from
+    /// the vertex itself (from the lifted point, the ceiling 0.2 m over a lamp read 3% too
+    /// bright in a scene 29 m across).
     fn next_events(
         &self,
         index: usize,
         path: &mut Path,
-        from: Vec3,
+        at: (Vec3, Vec3),
         smooth: &Smooth,
         queue: &mut Queue,
     ) {
         let scene = self.scene;
         let n = smooth.n;
+        let (x, from) = at;
         for light in self.points {
-            let to = light.position - from;
+            let to = light.position - x;
             let r2 = f64::from(to.length_squared());
             let cos = f64::from(n.dot(to.normalize_or_zero()));
             if cos > 0.0 && r2 > 0.0 {
@@ -707,7 +711,7 @@ impl Tracer<'_> {
             let y = v[0] * (1.0 - s) + v[1] * (s * (1.0 - r2)) + v[2] * (s * r2);
             let ke = scene.material_of(t.surface).ke.as_dvec3();
             let area_pdf = e.probability / f64::from(t.area);
-            let to = y - from;
+            let to = y - x;
             let d2 = f64::from(to.length_squared());
             let omega = to.normalize_or_zero();
             let cos_x = f64::from(n.dot(omega));
@@ -731,20 +735,21 @@ impl Tracer<'_> {
             });
         }
         if self.mirrors.depth() > 0 {
-            self.mirror_events(index, from, smooth, area.as_ref(), queue);
+            self.mirror_events(index, at, smooth, area.as_ref(), queue);
         }
     }
 
-    /// The lights' images in chains of planar mirrors, seen from `from`.
+    /// The lights' images in chains of planar mirrors, seen from the vertex `at.0` (shadow
+    /// probes leave from `at.1`, lifted off it).
     fn mirror_events(
         &self,
         index: usize,
-        from: Vec3,
+        at: (Vec3, Vec3),
         smooth: &Smooth,
         area: Option<&AreaSample>,
         queue: &mut Queue,
     ) {
-        let x = from.as_dvec3();
+        let (x, from) = (at.0.as_dvec3(), at.1);
         let n = smooth.n.as_dvec3();
         for chain in self.mirrors.chains() {
             for light in self.points {
@@ -845,7 +850,7 @@ impl Tracer<'_> {
         };
         let from = x + self.lift * n;
         if w_diffuse + w_lobe > 0.0 {
-            self.next_events(index, path, from, &smooth, queue);
+            self.next_events(index, path, (x, from), &smooth, queue);
         }
 
         path.bounces += 1;

@@ -28,12 +28,16 @@ pub use image::Image;
 
 /// Edge pixels of high contrast get up to this many times `supersample` rays per side...
 const MAX_EDGE_BOOST: usize = 8;
+/// A pool of light with no edge in it (the ceiling over a lamp) gets up to this many times
+/// `supersample` rays per side: its pixels' values are smooth, so the grid's error falls as
+/// the square of its side, not as the side.
+const MAX_POOL_BOOST: usize = 2;
 /// ... but no more than this many per side (unless `supersample` itself asks for more): the
 /// rim of a light 40 times the image's mean is measured to about a part in a thousand.
 const MAX_EDGE_SIDE: usize = 32;
 
-/// In scenes with specular surfaces, a pixel whose neighbour is brighter or darker by more
-/// than this many times the image's mean is supersampled like an edge.
+/// A pixel whose neighbour is brighter or darker by more than this many times the image's
+/// mean is supersampled like an edge.
 const CONTRAST_EDGE: f64 = 1.0;
 
 /// Rendering settings.
@@ -327,10 +331,10 @@ fn draw(
 
     // Edge pixels, refined with more rays.
     let edges = if all && options.supersample > 1 {
-        // In mirrors and on glossy surfaces an edge need not be one between sides: a
-        // light's highlight can be smaller than a pixel.
-        let contrast = shader.paths.is_some();
-        edge_pixels(&centre, w, h, options.supersample as usize, contrast)
+        // In mirrors and on glossy surfaces a value's edge may be a light's rim (its image):
+        // boosted as a rim between sides is.
+        let specular = shader.paths.is_some();
+        edge_pixels(&centre, w, h, options.supersample as usize, specular)
     } else {
         Edges::default()
     };
@@ -406,25 +410,26 @@ struct Edges {
 }
 
 /// Edge pixels: a neighbour, diagonal ones included (a corner may cut a pixel whose four
-/// nearest neighbours all see what it sees), sees another side; with `contrast`, also one
-/// whose brightest channel differs from the pixel's by more than [`CONTRAST_EDGE`] × the
-/// image's mean (a highlight or a light in a mirror, smaller than a pixel). Each gets `n` rays
-/// per side, more where the edge's contrast is high (the rim of a light): a jittered grid's
-/// coverage error scales with the contrast.
-fn edge_pixels(centre: &[(Vec3, u32)], w: usize, h: usize, n: usize, contrast: bool) -> Edges {
+/// nearest neighbours all see what it sees), sees another side, or its brightest channel
+/// differs from the pixel's by more than [`CONTRAST_EDGE`] × the image's mean (a highlight or
+/// a light in a mirror, smaller than a pixel; the ceiling a few decimetres over a lamp, whose
+/// pool a pixel's centre reads 10% above the pixel's mean). Each gets `n` rays per side, more
+/// where an edge between sides (or, with `specular`, any edge) has high contrast (the rim of a
+/// light): a jittered grid's coverage error scales with the contrast, while `n` × `n` rays
+/// measure a smooth pool to a part in a thousand.
+fn edge_pixels(centre: &[(Vec3, u32)], w: usize, h: usize, n: usize, specular: bool) -> Edges {
     let mean = centre
         .iter()
         .map(|c| f64::from(c.0.element_sum()))
         .sum::<f64>()
         / (3 * w * h) as f64;
     let step = (CONTRAST_EDGE * mean) as f32;
+    let between_sides = |p: usize| neighbours(p, w, h).any(|q| centre[q].1 != centre[p].1);
     let pixels: Vec<usize> = (0..w * h)
         .filter(|&p| {
             let here = centre[p].0.max_element();
-            neighbours(p, w, h).any(|q| {
-                centre[q].1 != centre[p].1
-                    || (contrast && (centre[q].0.max_element() - here).abs() > step)
-            })
+            between_sides(p)
+                || neighbours(p, w, h).any(|q| (centre[q].0.max_element() - here).abs() > step)
         })
         .collect();
     let per_side: Vec<usize> = pixels
@@ -434,8 +439,13 @@ fn edge_pixels(centre: &[(Vec3, u32)], w: usize, h: usize, n: usize, contrast: b
             let here = centre[p].0.max_element();
             let contrast = values().fold(here, f32::max) - values().fold(here, f32::min);
             let ratio = f64::from(contrast) / mean;
+            let most = if specular || between_sides(p) {
+                MAX_EDGE_BOOST
+            } else {
+                MAX_POOL_BOOST
+            };
             let m = if ratio.is_finite() && ratio > 1.0 {
-                (ratio.sqrt().ceil() as usize).min(MAX_EDGE_BOOST)
+                (ratio.sqrt().ceil() as usize).min(most)
             } else {
                 1
             };
