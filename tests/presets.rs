@@ -13,21 +13,23 @@ use meshlight::{Control, Options, Preset, Scene};
 fn the_epsilon_scale_multiplies_the_scenes_epsilon_and_never_an_explicit_one() {
     // The room's scene file asks for ε 0.25.
     let scene = Scene::load(shipped("room")).unwrap();
+    let vis = meshlight::Backend::Bvh.build(&scene).unwrap();
     let scaled = |scale: f32, epsilon: Option<f32>| {
         let options = Options {
             epsilon_scale: scale,
             epsilon,
             ..Options::default()
         };
-        choose_epsilon(&scene, &options).unwrap()
+        choose_epsilon(&scene, vis.as_ref(), &options).unwrap()
     };
     assert_eq!(scaled(1.0, None), (0.25, EpsilonSource::SceneFile));
     assert_eq!(scaled(0.5, None), (0.125, EpsilonSource::SceneFile));
     assert_eq!(scaled(0.5, Some(0.3)), (0.3, EpsilonSource::Options));
-    let final_epsilon = choose_epsilon(&scene, &Preset::Final.options()).unwrap().0;
+    let final_epsilon = choose_epsilon(&scene, vis.as_ref(), &Preset::Final.options())
+        .unwrap()
+        .0;
     assert_eq!(final_epsilon, 0.25 * 0.6, "the final preset takes 0.6 ε");
     // Out of its range, a solve names the knob.
-    let vis = meshlight::Backend::Bvh.build(&scene).unwrap();
     for bad in [0.0, -1.0, f32::NAN, 17.0] {
         let options = Options {
             epsilon_scale: bad,

@@ -638,3 +638,92 @@ fn the_ceiling_beside_a_light_panel_is_not_darkened_by_the_dark_under_it() {
         }
     }
 }
+
+/// A 4 × 3 × 4 m room (faces inwards) lit only by an uplight: a point light 0.3 m deep in an
+/// open-topped shade 0.4 m square, whose cone (33.7° from the vertical) reaches the ceiling
+/// within 1.6 m of its centre and nothing else: the walls and floor get only what the
+/// ceiling (and the shade) send them. Material 0 is the room's, 1 the shade's.
+fn uplit_room(two_sided: bool) -> Scene {
+    let mut b = Builder {
+        two_sided,
+        ..Builder::default()
+    };
+    let room = b.material(material("room", 0.7, 0.0));
+    let shade = b.material(material("shade", 0.5, 0.0));
+    b.room(Vec3::ZERO, Vec3::new(4.0, 3.0, 4.0), room, &[]);
+    b.room(
+        Vec3::new(1.8, 0.6, 1.8),
+        Vec3::new(2.2, 1.2, 2.2),
+        shade,
+        &["+y"],
+    );
+    b.point_lights.push(PointLight {
+        position: Vec3::new(2.0, 0.9, 2.0),
+        intensity: Vec3::splat(10.0),
+    });
+    b.scene(camera(
+        Vec3::new(0.5, 1.5, 0.5),
+        Vec3::new(3.0, 1.0, 3.0),
+        32,
+    ))
+}
+
+#[test]
+fn light_reaches_the_sides_it_bounces_onto_and_not_the_room_s_outsides() {
+    // Two-sided, the room's outer faces reflect too, but nothing reaches them; the walls and
+    // floor inside are reached only by what the ceiling reflects, the shade's outside by
+    // what the room reflects. Expected, by the geometry: the room's fronts, the shade's both
+    // sides, nothing else.
+    let scene = uplit_room(true);
+    let expected: Vec<u32> = meshlight::solver::reflecting_sides(&scene)
+        .into_iter()
+        .filter(|&side| {
+            let surface = &scene.surfaces()[(side / 2) as usize];
+            surface.material == 1 || side % 2 == 0
+        })
+        .collect();
+    assert_eq!(expected.len(), 6 + 2 * 5);
+    for backend in backends() {
+        let vis = backend.build(&scene).unwrap();
+        let lit = meshlight::solver::lit_sides(&scene, vis.as_ref()).unwrap();
+        assert_eq!(lit, expected, "{backend}");
+    }
+}
+
+#[test]
+fn a_two_sided_closed_room_is_solved_as_its_one_sided_self() {
+    // A closed room (faces inwards) and a floating box (faces outwards), a lamp between: with
+    // every face two-sided, the room's outsides and the box's insides are left without
+    // samples, so the automatic ε, the samples and the image are the one-sided scene's (they
+    // took half the samples and made ε √2 times coarser).
+    let scene = |two_sided: bool| {
+        let mut b = Builder {
+            two_sided,
+            ..Builder::default()
+        };
+        let white = b.material(material("white", 0.7, 0.0));
+        b.room(Vec3::ZERO, Vec3::new(4.0, 3.0, 4.0), white, &[]);
+        b.solid(Vec3::new(2.5, 0.5, 2.5), Vec3::new(3.1, 1.1, 3.1), white);
+        b.point_lights.push(PointLight {
+            position: Vec3::new(1.5, 2.4, 1.5),
+            intensity: Vec3::splat(10.0),
+        });
+        b.scene(camera(
+            Vec3::new(0.5, 1.5, 0.5),
+            Vec3::new(3.0, 1.0, 3.0),
+            32,
+        ))
+    };
+    let (one, two) = (scene(false), scene(true));
+    for backend in backends() {
+        let (a, image_a) = common::solve_and_render(&one, backend, Options::default(), true);
+        let (b, image_b) = common::solve_and_render(&two, backend, Options::default(), true);
+        assert_eq!(a.epsilon(), b.epsilon(), "{backend}: ε");
+        assert_eq!(a.samples().len(), b.samples().len(), "{backend}: samples");
+        let (ma, mb) = (image_a.mean(), image_b.mean());
+        assert!(
+            (ma / mb - 1.0).abs() < 1e-3,
+            "{backend}: image means {ma} one-sided, {mb} two-sided"
+        );
+    }
+}

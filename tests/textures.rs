@@ -341,11 +341,22 @@ fn the_image_shows_each_texel_under_the_light() {
     // the image shows black on the left and white × E / π on the right — the texture at full
     // resolution, not the samples' grey means. Pixel (4, 4)'s centre looks at (0.644, 0.356),
     // 0.144 m off the light's foot in x and y: E = cos³θ, cos θ = 1 / √(1 + 2 · 0.144²), 0.94
-    // (by hand); pixel (3, 4)'s at (0.356, 0.356), on the black half.
+    // (by hand); pixel (3, 4)'s at (0.356, 0.356), on the black half. One ray a pixel: the
+    // pixels are read at their centres (a supersampled pixel averages its footprint, and
+    // (3, 4)'s reaches the half-texel ramp of the bilinear lookup next to the white half).
     let mtl = "newmtl paper\nKd 0.8 0.8 0.8\nmap_Kd tex.png\n";
     let scene = load(QUAD, mtl, &[("tex.png", two_halves())]).unwrap();
     for backend in backends() {
-        let (_, image) = solve_and_render(&scene, backend, Options::default(), true);
+        let (solution, _) = solve_and_render(&scene, backend, Options::default(), false);
+        let vis = backend.build(&scene).unwrap();
+        let options = meshlight::RenderOptions {
+            supersample: 1,
+            ..meshlight::RenderOptions::default()
+        };
+        let (image, _) = meshlight::render(&scene, &solution, vis.as_ref(), &options, &mut |_| {
+            meshlight::Control::Continue
+        })
+        .unwrap();
         let at = |x: u32, y: u32| image.pixels[(y * image.width + x) as usize].x;
         let white = 0.8 * 0.9 / std::f32::consts::PI; // Kd × the texel (1, bounded to 0.9)
         let (right, left) = (at(4, 4), at(3, 4));

@@ -289,7 +289,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
             (traced.image, summary)
         }
         Method::Patches => {
-            let patch_options = patch_options(&scene, &r, &options)?;
+            let patch_options = patch_options(&scene, vis.as_ref(), &r, &options)?;
             let solved = reference::patches_with_progress(&scene, vis.as_ref(), &patch_options)?;
             let summary =
                 reference::patch_summary(&scene, &solved, &patch_options, &options, vis.name());
@@ -368,13 +368,14 @@ fn path_options(r: &RenderArgs, options: &meshlight::Options) -> meshlight::refe
 /// given).
 fn patch_options(
     scene: &Scene,
+    vis: &dyn meshlight::Visibility,
     r: &RenderArgs,
     options: &meshlight::Options,
 ) -> anyhow::Result<meshlight::reference::PatchOptions> {
     Ok(meshlight::reference::PatchOptions {
         patch_size: match r.render.patch_size {
             Some(h) => h,
-            None => meshlight::solver::choose_epsilon(scene, options)?.0,
+            None => meshlight::solver::choose_epsilon(scene, vis, options)?.0,
         },
         supersample: r
             .render

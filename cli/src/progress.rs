@@ -68,10 +68,10 @@ pub fn solve_with_progress(
     vis: &dyn Visibility,
     options: &Options,
 ) -> anyhow::Result<Solution> {
-    let (epsilon, source) = meshlight::solver::choose_epsilon(scene, options)?;
+    let (epsilon, source) = meshlight::solver::choose_epsilon(scene, vis, options)?;
     if source == EpsilonSource::Automatic {
         eprintln!(
-            "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area (about {} initial samples{})",
+            "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area light reaches (about {} initial samples{})",
             meshlight::solver::AUTO_SAMPLES,
             if options.epsilon_scale == 1.0 {
                 String::new()
@@ -81,6 +81,21 @@ pub fn solve_with_progress(
                     options.epsilon_scale
                 )
             }
+        );
+    }
+    let all = meshlight::solver::reflecting_sides(scene);
+    let lit = meshlight::solver::lit_sides(scene, vis)?;
+    if lit.len() < all.len() {
+        let (lit_area, area) = (
+            meshlight::solver::area_of(scene, &lit),
+            meshlight::solver::area_of(scene, &all),
+        );
+        eprintln!(
+            "meshlight: {} of {} reflecting sides ({:.0}% of their area) get no samples: no light \
+             reaches them (the outsides and insides of two-sided objects); they render black",
+            all.len() - lit.len(),
+            all.len(),
+            100.0 * (1.0 - lit_area / area)
         );
     }
     Ok(with_progress("solve", |progress| {

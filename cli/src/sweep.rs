@@ -439,7 +439,7 @@ fn measure(
             let patch = meshlight::reference::PatchOptions {
                 patch_size: match extra.patch_size {
                     Some(h) => h,
-                    None => meshlight::solver::choose_epsilon(scene, options)?.0,
+                    None => meshlight::solver::choose_epsilon(scene, vis, options)?.0,
                 },
                 supersample: extra.supersample,
                 tolerance: options.tolerance,

@@ -56,9 +56,7 @@ pub(crate) fn rays(
 /// A unit direction, cosine-distributed about `n`.
 fn cosine_direction(n: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
     let (u1, u2): (f32, f32) = (rng.random(), rng.random());
-    let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
-    let (t, b) = n.any_orthonormal_pair();
-    (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
+    crate::sampling::directions::cosine(n, u1, u2)
 }
 
 #[cfg(test)]

@@ -31,8 +31,10 @@
 //! luminaires: a point light behind or inside thick glass lights nothing the camera sees
 //! through that glass, and caustics of area lights through it converge slowly. Thin panes are
 //! exact both ways. Mirrors are planar (each surface its plane); the chains looked through are
-//! capped at 1,024, the depth lowered to fit. Shading points are lifted off their surfaces by
-//! 10⁻⁴ of the scene's diagonal, which shortens distances to lights by as much.
+//! capped at 1,024, the depth lowered to fit. Rays leave a vertex lifted off its surface by
+//! 10⁻⁴ of the scene's diagonal; the lights' distances and angles are measured from the vertex
+//! itself (from the lifted point, a ceiling 0.2 m over a lamp in a scene 29 m across read 3%
+//! too bright).
 //!
 //! Russian roulette from the fourth bounce. Paths advance in waves: each bounce's rays, shadow
 //! segments and probes go to the backend in batches. Every path draws from its own generator,

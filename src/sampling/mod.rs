@@ -4,7 +4,9 @@
 
 pub mod adaptive;
 pub(crate) mod cover;
+pub(crate) mod directions;
 mod layout;
+pub mod lit;
 pub mod obstruction;
 pub mod poisson;
 pub(crate) mod reflectance;
@@ -16,6 +18,7 @@ use glam::{Vec2, Vec3};
 
 use crate::scene::Scene;
 pub(crate) use layout::Layout;
+pub use lit::lit_sides;
 pub use obstruction::Obstruction;
 pub(crate) use shares::Shares;
 pub use surface_map::SurfaceMap;

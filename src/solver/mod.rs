@@ -34,8 +34,8 @@ use crate::light::{DirectLight, Reach};
 use crate::progress::Reporter;
 pub use crate::progress::{Control, Phase, Progress};
 use crate::sampling::Layout;
-pub use crate::sampling::Samples;
-use crate::sampling::{reflecting_sides, surface_of, Obstruction, SurfaceMap};
+pub use crate::sampling::{lit_sides, reflecting_sides, Samples, Side};
+use crate::sampling::{surface_of, Obstruction, SurfaceMap};
 use crate::scene::Scene;
 pub use crate::specular::{summary as specular_summary, SpecularSummary, MAX_SPECULAR_DEPTH};
 use crate::visibility::Visibility;
@@ -275,13 +275,28 @@ pub(crate) const SKY_RAYS: u32 = 128;
 /// The largest ε a solve takes, in diagonals of the scene's bounds.
 pub const MAX_EPSILON_DIAGONALS: f32 = 100.0;
 
-/// The ε a solve will use, and where it came from.
-pub fn choose_epsilon(scene: &Scene, options: &Options) -> Result<(f32, EpsilonSource)> {
+/// The ε a solve will use, and where it came from. An automatic ε spreads its samples over the
+/// reflecting sides light can reach ([`lit_sides`], which casts rays: hence `vis`).
+pub fn choose_epsilon(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    options: &Options,
+) -> Result<(f32, EpsilonSource)> {
+    epsilon_over(scene, options, || lit_sides(scene, vis))
+}
+
+/// [`choose_epsilon`] with the sides to sample given by `sides`, asked for only when the ε is
+/// automatic.
+fn epsilon_over(
+    scene: &Scene,
+    options: &Options,
+    sides: impl FnOnce() -> Result<Vec<Side>>,
+) -> Result<(f32, EpsilonSource)> {
     let (epsilon, source) = match (options.epsilon, scene.solver.epsilon) {
         (Some(e), _) => (e, EpsilonSource::Options),
         (None, Some(e)) => (e * options.epsilon_scale, EpsilonSource::SceneFile),
         (None, None) => {
-            let area = reflecting_area(scene);
+            let area = area_of(scene, &sides()?);
             // Poisson-disk sets reach about 0.7 / ε² samples per unit area.
             let e = (0.7 * area / AUTO_SAMPLES).sqrt() as f32;
             (
@@ -318,18 +333,18 @@ pub fn choose_epsilon(scene: &Scene, options: &Options) -> Result<(f32, EpsilonS
     Ok((epsilon, source))
 }
 
-fn reflecting_area(scene: &Scene) -> f64 {
-    reflecting_sides(scene)
+/// The area of `sides`, both of a two-sided surface counted.
+pub fn area_of(scene: &Scene, sides: &[Side]) -> f64 {
+    sides
         .iter()
         .map(|&s| scene.surfaces[surface_of(s) as usize].area)
         .sum()
 }
 
-/// Predicted initial sample count for ε (upper estimate: the jamming density 0.7/ε² plus one
-/// per side), to refuse a too-small ε before allocating.
-pub fn predicted_samples(scene: &Scene, epsilon: f32) -> f64 {
-    let sides = reflecting_sides(scene);
-    0.7 * reflecting_area(scene) / f64::from(epsilon).powi(2) + sides.len() as f64
+/// Predicted initial sample count for ε on `sides` (upper estimate: the jamming density
+/// 0.7/ε² plus one per side), to refuse a too-small ε before allocating.
+pub fn predicted_samples(scene: &Scene, sides: &[Side], epsilon: f32) -> f64 {
+    0.7 * area_of(scene, sides) / f64::from(epsilon).powi(2) + sides.len() as f64
 }
 
 /// Solves a scene: see the module doc. `progress` hears every phase and every few shots, and
@@ -371,8 +386,8 @@ pub fn solve_distributed(
 
 /// Refuses an ε that would place more samples than `options.max_samples`, or samples that
 /// would take more than half the memory budget, before anything is allocated.
-fn refuse_too_many(scene: &Scene, options: &Options, epsilon: f32) -> Result<()> {
-    let predicted = predicted_samples(scene, epsilon);
+fn refuse_too_many(scene: &Scene, sides: &[Side], options: &Options, epsilon: f32) -> Result<()> {
+    let predicted = predicted_samples(scene, sides, epsilon);
     if predicted > options.max_samples as f64 {
         return Err(Error::Option {
             option: "epsilon",
@@ -420,8 +435,9 @@ fn solve_with(
     method: Method,
 ) -> Result<Solution> {
     options.validate()?;
-    let (epsilon, epsilon_source) = choose_epsilon(scene, options)?;
-    refuse_too_many(scene, options, epsilon)?;
+    let sides = lit_sides(scene, vis)?;
+    let (epsilon, epsilon_source) = epsilon_over(scene, options, || Ok(sides.clone()))?;
+    refuse_too_many(scene, &sides, options, epsilon)?;
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
     let obstruction = Obstruction::new(scene, &maps, lift);
@@ -450,6 +466,7 @@ fn solve_with(
         grid: (method == Method::Hierarchy).then(|| TriangleGrid::new(scene)),
         lift,
         epsilon,
+        sides,
         reporter: Reporter::new(progress),
         ranks,
         light_scale: glam::DVec3::ONE,

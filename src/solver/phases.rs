@@ -17,7 +17,7 @@ use crate::light::{Arrival, DirectLight};
 use crate::parallel::for_chunks_reporting;
 use crate::progress::{Control, Phase, Progress, Reporter};
 use crate::sampling::adaptive::{self, RefineSettings};
-use crate::sampling::{cover, poisson, reflecting_sides, surface_of, Samples, SurfaceMap};
+use crate::sampling::{cover, poisson, reflecting_sides, surface_of, Samples, Side, SurfaceMap};
 use crate::scene::Scene;
 use crate::specular::lights::Lights;
 use crate::specular::Specular;
@@ -36,6 +36,8 @@ pub(super) struct Solve<'a> {
     pub(super) grid: Option<TriangleGrid>,
     pub(super) lift: f32,
     pub(super) epsilon: f32,
+    /// The sides that get samples: those light can reach ([`crate::sampling::lit_sides`]).
+    pub(super) sides: Vec<Side>,
     pub(super) reporter: Reporter<'a>,
     /// The processes the solve is spread over (see `distributed`).
     pub(super) ranks: &'a dyn crate::distributed::Ranks,
@@ -126,11 +128,11 @@ impl<'a> Solve<'a> {
         self.reporter.report(base)
     }
 
-    /// Poisson-disk samples on every reflecting side (eq. 3), each side seeded on its own. A
+    /// Poisson-disk samples on every side light reaches (eq. 3), each side seeded on its own. A
     /// Stop leaves the sides not reached yet without samples.
     pub(super) fn initial_samples(&mut self, maps: &[SurfaceMap]) -> Result<Samples> {
         self.begin(Phase::Sampling, 0, 0);
-        let sides = reflecting_sides(self.scene);
+        let sides = &self.sides;
         let mut per_side: Vec<Vec<glam::Vec2>> = vec![Vec::new(); sides.len()];
         let (epsilon, seed) = (self.epsilon, self.options.seed);
         let threads = self.options.threads.max(1);

@@ -26,6 +26,7 @@ use super::Specular;
 use crate::error::Result;
 use crate::material::{fresnel, reflect};
 use crate::parallel::{for_chunks_reporting, Report};
+use crate::sampling::directions::cosine;
 use crate::sampling::poisson::side_seed;
 use crate::sampling::{side_of, Side};
 use crate::scene::{Kind, Scene};
@@ -453,13 +454,6 @@ fn in_cone(axis: Vec3, cos_max: f32, u1: f32, u2: f32) -> Vec3 {
     let phi = std::f32::consts::TAU * u2;
     let (t, b) = axis.any_orthonormal_pair();
     (t * (sin * phi.cos()) + b * (sin * phi.sin()) + axis * cos).normalize()
-}
-
-/// A cosine-weighted direction around unit `n`.
-fn cosine(n: Vec3, u1: f32, u2: f32) -> Vec3 {
-    let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
-    let (t, b) = n.any_orthonormal_pair();
-    (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
 }
 
 /// `count` photons shared among (light, object) pairs by the power each light sends towards

@@ -61,6 +61,8 @@ pub fn material(name: &str, kd: f32, ke: f32) -> Material {
 pub struct Builder {
     pub mesh: Mesh,
     pub point_lights: Vec<PointLight>,
+    /// Whether faces reflect on both sides (the scene file's `two_sided`).
+    pub two_sided: bool,
 }
 
 impl Builder {
@@ -162,7 +164,7 @@ impl Builder {
             mesh: self.mesh,
             point_lights: self.point_lights,
             camera,
-            two_sided: false,
+            two_sided: self.two_sided,
             solver: SolverDefaults::default(),
         };
         Scene::from_parts("test scene", parts).unwrap_or_else(|e| panic!("{e}"))
