@@ -702,6 +702,8 @@ fn a_two_sided_closed_room_is_solved_as_its_one_sided_self() {
             ..Builder::default()
         };
         let white = b.material(material("white", 0.7, 0.0));
+        // A glass listed but used by nothing (an MTL file's spare) changes nothing.
+        b.material(common::glass("spare", 1.5, false));
         b.room(Vec3::ZERO, Vec3::new(4.0, 3.0, 4.0), white, &[]);
         b.solid(Vec3::new(2.5, 0.5, 2.5), Vec3::new(3.1, 1.1, 3.1), white);
         b.point_lights.push(PointLight {

@@ -44,7 +44,11 @@ const SEED: u64 = 0x6c69_745f_7369_6465;
 /// reaches any (a dark scene is said so elsewhere, on all its sides).
 pub fn lit_sides(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Side>> {
     let all = reflecting_sides(scene);
-    let specular = scene.materials.iter().any(|m| m.is_specular());
+    // Only the materials surfaces use: an MTL file may list a glass nothing is made of.
+    let specular = scene
+        .surfaces
+        .iter()
+        .any(|s| scene.materials[s.material as usize].is_specular());
     let candidate = |side: Side| scene.surfaces[surface_of(side) as usize].two_sided;
     if scene.daylight.is_some() || specular || !all.iter().any(|&s| candidate(s)) {
         return Ok(all);
