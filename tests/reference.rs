@@ -10,6 +10,18 @@ use meshlight::reference::{path_trace, PathImage, PathOptions};
 use meshlight::scene::PointLight;
 use meshlight::{Backend, Scene};
 
+/// [`trace`] at `spp` samples per pixel, the other options their defaults.
+fn trace_spp(scene: &Scene, backend: Backend, spp: u32) -> PathImage {
+    trace(
+        scene,
+        backend,
+        PathOptions {
+            spp,
+            ..PathOptions::default()
+        },
+    )
+}
+
 fn trace(scene: &Scene, backend: Backend, options: PathOptions) -> PathImage {
     let vis = backend.build(scene).unwrap();
     path_trace(scene, vis.as_ref(), &options, &mut |_| {
@@ -128,14 +140,7 @@ fn a_point_light_over_a_plane_gives_kd_over_pi_times_i_cos_over_r_squared() {
         Vec3::ZERO,
     );
     for backend in backends() {
-        let traced = trace(
-            &scene,
-            backend,
-            PathOptions {
-                spp: 256,
-                ..PathOptions::default()
-            },
-        );
+        let traced = trace_spp(&scene, backend, 256);
         for (i, (p, &expected)) in traced.image.pixels.iter().zip(&expected).enumerate() {
             let got = f64::from(p.x);
             assert!(
@@ -168,14 +173,7 @@ fn a_point_light_just_over_a_plane_is_measured_from_the_plane_not_from_the_lifte
     let sum = |values: &dyn Fn(usize) -> f64| pool.iter().map(|&i| values(i)).sum::<f64>();
     let exact = sum(&|i| expected[i]);
     for backend in backends() {
-        let traced = trace(
-            &scene,
-            backend,
-            PathOptions {
-                spp: 256,
-                ..PathOptions::default()
-            },
-        );
+        let traced = trace_spp(&scene, backend, 256);
         let got = sum(&|i| f64::from(traced.image.pixels[i].x));
         assert!(
             (got / exact - 1.0).abs() < 0.01,

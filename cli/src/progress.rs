@@ -68,7 +68,10 @@ pub fn solve_with_progress(
     vis: &dyn Visibility,
     options: &Options,
 ) -> anyhow::Result<Solution> {
-    let (epsilon, source) = meshlight::solver::choose_epsilon(scene, vis, options)?;
+    // Which sides light reaches, cast once for the ε and the message (the solve casts its own).
+    let all = meshlight::solver::reflecting_sides(scene);
+    let lit = meshlight::solver::lit_sides(scene, vis)?;
+    let (epsilon, source) = meshlight::solver::choose_epsilon_for(scene, &lit, options)?;
     if source == EpsilonSource::Automatic {
         eprintln!(
             "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area light reaches (about {} initial samples{})",
@@ -83,8 +86,6 @@ pub fn solve_with_progress(
             }
         );
     }
-    let all = meshlight::solver::reflecting_sides(scene);
-    let lit = meshlight::solver::lit_sides(scene, vis)?;
     if lit.len() < all.len() {
         let (lit_area, area) = (
             meshlight::solver::area_of(scene, &lit),

@@ -285,6 +285,15 @@ pub fn choose_epsilon(
     epsilon_over(scene, options, || lit_sides(scene, vis))
 }
 
+/// [`choose_epsilon`] for a caller that has [`lit_sides`] already (they are not cast again).
+pub fn choose_epsilon_for(
+    scene: &Scene,
+    sides: &[Side],
+    options: &Options,
+) -> Result<(f32, EpsilonSource)> {
+    epsilon_over(scene, options, || Ok(sides.to_vec()))
+}
+
 /// [`choose_epsilon`] with the sides to sample given by `sides`, asked for only when the ε is
 /// automatic.
 fn epsilon_over(
@@ -436,7 +445,7 @@ fn solve_with(
 ) -> Result<Solution> {
     options.validate()?;
     let sides = lit_sides(scene, vis)?;
-    let (epsilon, epsilon_source) = epsilon_over(scene, options, || Ok(sides.clone()))?;
+    let (epsilon, epsilon_source) = choose_epsilon_for(scene, &sides, options)?;
     refuse_too_many(scene, &sides, options, epsilon)?;
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
