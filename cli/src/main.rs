@@ -158,6 +158,30 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
         Command::Info { scene } => {
             let scene = load(&scene, loading)?;
             print!("{}", info(&scene));
+            let vis = meshlight::Backend::default_backend().build(&scene)?;
+            let sides = meshlight::solver::lit_sides(&scene, vis.as_ref())?;
+            match meshlight::solver::light_length(&scene, vis.as_ref(), &sides)? {
+                Some(l) => {
+                    println!(
+                        "free path     {:.6} (mean, from the sides light reaches)",
+                        l.free_path
+                    );
+                    if let Some(h) = l.lamp_clearance {
+                        println!("lamps         the nearest surface {h:.6} from a lamp");
+                    }
+                    println!(
+                        "light length  {:.6}: preview's ε {:.6}; final's {:.6} (the free path's: \
+                         its rounds resolve lamps' pools)",
+                        l.length,
+                        l.length * f64::from(meshlight::solver::PREVIEW_EPSILON_FRACTION),
+                        l.free_path * f64::from(meshlight::solver::FINAL_EPSILON_FRACTION)
+                    );
+                }
+                None => println!(
+                    "free path     none: the scene is open (most rays from its surfaces meet \
+                     nothing); the presets take the area rule"
+                ),
+            }
             // What sky each grid sees, where daylight enters (a ray caster is needed).
             if scene.daylight().is_some() && !scene.grids().is_empty() {
                 let vis = meshlight::Backend::default_backend().build(&scene)?;

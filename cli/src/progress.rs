@@ -71,7 +71,7 @@ pub fn solve_with_progress(
     // Which sides light reaches, cast once for the ε and the message (the solve casts its own).
     let all = meshlight::solver::reflecting_sides(scene);
     let lit = meshlight::solver::lit_sides(scene, vis)?;
-    let (epsilon, source) = meshlight::solver::choose_epsilon_for(scene, &lit, options)?;
+    let (epsilon, source) = meshlight::solver::choose_epsilon_for(scene, vis, &lit, options)?;
     if source == EpsilonSource::Automatic {
         eprintln!(
             "meshlight: no epsilon given: chose ε = {epsilon:.4} from the reflecting area light reaches (about {} initial samples{})",
@@ -85,6 +85,22 @@ pub fn solve_with_progress(
                 )
             }
         );
+    }
+    if source == EpsilonSource::LightLength {
+        if let Some(l) = meshlight::solver::light_length(scene, vis, &lit)? {
+            let lamps = match l.lamp_clearance {
+                Some(h) if l.length < l.free_path && options.rounds == 0 => {
+                    format!(", shortened by a lamp {h:.3} from a surface")
+                }
+                _ => String::new(),
+            };
+            eprintln!(
+                "meshlight: ε = {epsilon:.4}: {} of the length over which the scene's light changes, {:.3} (its mean free path {:.3}{lamps}); a scene file's ε is for the default preset",
+                options.epsilon_fraction.unwrap_or(0.0) * options.epsilon_scale,
+                if options.rounds == 0 { l.length } else { l.free_path },
+                l.free_path,
+            );
+        }
     }
     if lit.len() < all.len() {
         let (lit_area, area) = (

@@ -422,10 +422,13 @@ fn summary_settings(out: &mut String, scene: &Scene, s: &Solution, o: &Options, 
         EpsilonSource::Options => "command line",
         EpsilonSource::SceneFile => "scene file",
         EpsilonSource::Automatic => "automatic",
+        EpsilonSource::LightLength => "the scene's light length",
         _ => "",
     };
     let scaled = match s.epsilon_source() {
-        EpsilonSource::SceneFile | EpsilonSource::Automatic if o.epsilon_scale != 1.0 => {
+        EpsilonSource::SceneFile | EpsilonSource::Automatic | EpsilonSource::LightLength
+            if o.epsilon_scale != 1.0 =>
+        {
             format!(" × {}", o.epsilon_scale)
         }
         _ => String::new(),

@@ -225,6 +225,51 @@ fn no_epsilon_means_an_automatic_one_that_is_announced() {
     );
 }
 
+#[test]
+fn the_preview_says_where_its_epsilon_came_from_and_info_gives_the_same_length() {
+    // The box's file asks for ε 0.1; the preview takes 0.14 of the free path `info` prints
+    // (the box has no lamps to shorten it).
+    let info = meshlight(&["info", root("scenes/box/scene.toml").to_str().unwrap()]);
+    assert!(info.status.success(), "{}", text(&info.stderr));
+    let info = text(&info.stdout);
+    let free_path: f64 = info
+        .lines()
+        .find_map(|l| l.strip_prefix("free path"))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{info}"));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a.exr");
+    let run = meshlight(&[
+        "render",
+        root("scenes/box/scene.toml").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--preset",
+        "preview",
+        "--width",
+        "16",
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert!(
+        text(&run.stderr).contains("of the length over which the scene's light changes"),
+        "{}",
+        text(&run.stderr)
+    );
+    let stdout = text(&run.stdout);
+    let epsilon: f64 = stdout
+        .split("ε ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(stdout.contains("(the scene's light length)"), "{stdout}");
+    assert!(
+        (epsilon / (0.14 * free_path) - 1.0).abs() < 1e-4,
+        "ε {epsilon} against 0.14 × {free_path}"
+    );
+}
+
 fn write_pair(dir: &std::path::Path, b: &[[f32; 3]], a: &[[f32; 3]]) -> (String, String) {
     let image = |p: &[[f32; 3]]| meshlight::Image {
         width: p.len() as u32,
@@ -926,9 +971,20 @@ fn a_preset_sets_the_render_too_and_given_options_override_it() {
         "{preview} vs {default}"
     );
     assert!(overridden > 3 * preview, "{overridden} vs {preview}");
-    // The final preset takes 0.6 of the scene file's ε (0.1 for the box) and says so.
+    // The final preset takes 0.04 of the scene's free path, not the file's ε (0.1 for the
+    // box), and says so: the box is a closed unit cube, whose free path is 4V/S = 2/3.
     let (_, out) = shadow_rays(&["--preset", "final", "--supersample", "1"]);
-    assert!(out.contains("ε 0.06 (scene file × 0.6)"), "{out}");
+    assert!(out.contains("(the scene's light length)"), "{out}");
+    let epsilon: f64 = out
+        .split("ε ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        (epsilon / (0.04 * 2.0 / 3.0) - 1.0).abs() < 0.01,
+        "ε {epsilon}"
+    );
 }
 
 #[test]

@@ -76,12 +76,7 @@ pub fn lit_sides(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Side>> {
         .map(|&s| scene.surfaces[surface_of(s) as usize].area)
         .sum();
     let lift = crate::visibility::lift(scene);
-    let lights: Vec<Vec3> = scene
-        .point_lights
-        .iter()
-        .map(|l| l.position)
-        .chain(scene.luminaires.iter().map(|l| l.position))
-        .collect();
+    let lights: Vec<Vec3> = scene.lamp_positions().collect();
     // The candidates' probes, in batches of segments to the lights and of rays (a few
     // thousand sides at a time, so a scene of many small faces does not hold all at once).
     let mut seen_from: Vec<Vec<Side>> = vec![Vec::new(); candidates.len()];
@@ -166,7 +161,12 @@ pub fn lit_sides(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Side>> {
 }
 
 /// `count` points spread by area over a side (lifted off it), and the side's normal.
-fn probe_points(scene: &Scene, side: Side, count: usize, lift: f32) -> (Vec<Vec3>, Vec3) {
+pub(super) fn probe_points(
+    scene: &Scene,
+    side: Side,
+    count: usize,
+    lift: f32,
+) -> (Vec<Vec3>, Vec3) {
     let surface = &scene.surfaces[surface_of(side) as usize];
     let normal = if is_back(side) {
         -surface.normal

@@ -5,6 +5,7 @@
 pub mod adaptive;
 pub(crate) mod cover;
 pub(crate) mod directions;
+pub mod free_path;
 mod layout;
 pub mod lit;
 pub mod obstruction;

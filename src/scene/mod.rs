@@ -310,6 +310,14 @@ impl Scene {
         &self.surfaces
     }
 
+    /// Where the point lights and luminaires stand, point lights first.
+    pub(crate) fn lamp_positions(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.point_lights
+            .iter()
+            .map(|l| l.position)
+            .chain(self.luminaires.iter().map(|l| l.position))
+    }
+
     /// Point lights.
     pub fn point_lights(&self) -> &[PointLight] {
         &self.point_lights

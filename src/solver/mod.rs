@@ -33,6 +33,7 @@ pub use crate::light::Arrival;
 use crate::light::{DirectLight, Reach};
 use crate::progress::Reporter;
 pub use crate::progress::{Control, Phase, Progress};
+pub use crate::sampling::free_path::{lamp_clearance, light_length, mean_free_path, LightLength};
 use crate::sampling::Layout;
 pub use crate::sampling::{lit_sides, reflecting_sides, Samples, Side};
 use crate::sampling::{surface_of, Obstruction, SurfaceMap};
@@ -42,8 +43,8 @@ use crate::visibility::Visibility;
 use cluster::coherence::TriangleGrid;
 pub use options::{knob, Knob, KNOBS, MAX_PIPELINE_CAPACITY, MAX_THREADS};
 pub use options::{
-    Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH, MAX_PHOTONS,
-    MAX_SPECULAR_RAYS,
+    Options, Preset, AUTO_SAMPLES, DEFAULT_CLUSTER_THRESHOLD, DEFAULT_SPECULAR_DEPTH,
+    FINAL_EPSILON_FRACTION, MAX_PHOTONS, MAX_SPECULAR_RAYS, PREVIEW_EPSILON_FRACTION,
 };
 use phases::{AddedSamples, Solve};
 pub use stats::{EnergyLedger, PhaseSeconds, RoundStats, ShootStats, StopReason};
@@ -239,6 +240,9 @@ pub enum EpsilonSource {
     SceneFile,
     /// Chosen from the scene's reflecting area.
     Automatic,
+    /// A fraction of the scene's [`light_length`] ([`Options::epsilon_fraction`]: the presets
+    /// `preview` and `final`).
+    LightLength,
 }
 
 impl Solution {
@@ -276,48 +280,81 @@ pub(crate) const SKY_RAYS: u32 = 128;
 pub const MAX_EPSILON_DIAGONALS: f32 = 100.0;
 
 /// The ε a solve will use, and where it came from. An automatic ε spreads its samples over the
-/// reflecting sides light can reach ([`lit_sides`], which casts rays: hence `vis`).
+/// reflecting sides light can reach ([`lit_sides`]), and a preset's measures the scene's
+/// [`light_length`]: both cast rays, hence `vis`.
 pub fn choose_epsilon(
     scene: &Scene,
     vis: &dyn Visibility,
     options: &Options,
 ) -> Result<(f32, EpsilonSource)> {
-    epsilon_over(scene, options, || lit_sides(scene, vis))
+    epsilon_over(scene, vis, options, || lit_sides(scene, vis))
 }
 
 /// [`choose_epsilon`] for a caller that has [`lit_sides`] already (they are not cast again).
 pub fn choose_epsilon_for(
     scene: &Scene,
+    vis: &dyn Visibility,
     sides: &[Side],
     options: &Options,
 ) -> Result<(f32, EpsilonSource)> {
-    epsilon_over(scene, options, || Ok(sides.to_vec()))
+    epsilon_over(scene, vis, options, || Ok(sides.to_vec()))
 }
 
 /// [`choose_epsilon`] with the sides to sample given by `sides`, asked for only when the ε is
-/// automatic.
+/// chosen here.
 fn epsilon_over(
     scene: &Scene,
+    vis: &dyn Visibility,
     options: &Options,
     sides: impl FnOnce() -> Result<Vec<Side>>,
 ) -> Result<(f32, EpsilonSource)> {
-    let (epsilon, source) = match (options.epsilon, scene.solver.epsilon) {
-        (Some(e), _) => (e, EpsilonSource::Options),
-        (None, Some(e)) => (e * options.epsilon_scale, EpsilonSource::SceneFile),
-        (None, None) => {
-            let area = area_of(scene, &sides()?);
-            // Poisson-disk sets reach about 0.7 / ε² samples per unit area.
-            let e = (0.7 * area / AUTO_SAMPLES).sqrt() as f32;
-            (
-                options.epsilon_scale
-                    * if e > 0.0 {
-                        e
-                    } else {
-                        scene.bounds.diagonal() / 50.0
-                    },
-                EpsilonSource::Automatic,
-            )
+    // The area rule: about AUTO_SAMPLES initial samples (Poisson-disk sets reach about
+    // 0.7 / ε² samples per unit area).
+    let by_area = |area: f64| {
+        let e = (0.7 * area / AUTO_SAMPLES).sqrt() as f32;
+        if e > 0.0 {
+            e
+        } else {
+            scene.bounds.diagonal() / 50.0
         }
+    };
+    let (epsilon, source) = match (
+        options.epsilon,
+        options.epsilon_fraction,
+        scene.solver.epsilon,
+    ) {
+        (Some(e), _, _) => (e, EpsilonSource::Options),
+        (None, Some(fraction), _) => {
+            let sides = sides()?;
+            let area = area_of(scene, &sides);
+            match light_length(scene, vis, &sides)? {
+                Some(l) => {
+                    // A lamp's pool is resolved by the adaptive rounds where there are any;
+                    // without them ε itself follows it.
+                    let length = if options.rounds == 0 {
+                        l.length
+                    } else {
+                        l.free_path
+                    };
+                    // However short the length, the preset leaves room for its rounds: at most
+                    // an eighth of max_samples to start with.
+                    let floor = (0.7 * area / (options.max_samples as f64 / 8.0).max(1.0)).sqrt();
+                    (
+                        options.epsilon_scale * (f64::from(fraction) * length).max(floor) as f32,
+                        EpsilonSource::LightLength,
+                    )
+                }
+                None => (
+                    options.epsilon_scale * by_area(area),
+                    EpsilonSource::Automatic,
+                ),
+            }
+        }
+        (None, None, Some(e)) => (e * options.epsilon_scale, EpsilonSource::SceneFile),
+        (None, None, None) => (
+            options.epsilon_scale * by_area(area_of(scene, &sides()?)),
+            EpsilonSource::Automatic,
+        ),
     };
     if !(epsilon.is_finite() && epsilon > 0.0) {
         return Err(Error::Option {
@@ -445,7 +482,7 @@ fn solve_with(
 ) -> Result<Solution> {
     options.validate()?;
     let sides = lit_sides(scene, vis)?;
-    let (epsilon, epsilon_source) = choose_epsilon_for(scene, &sides, options)?;
+    let (epsilon, epsilon_source) = choose_epsilon_for(scene, vis, &sides, options)?;
     refuse_too_many(scene, &sides, options, epsilon)?;
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);

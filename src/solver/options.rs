@@ -24,6 +24,15 @@ pub struct Options {
     /// [`Options::epsilon`]), 1/16 to 16: presets use it to trade samples for time whatever
     /// scale the scene was modelled at. Default 1.
     pub epsilon_scale: f32,
+    /// ε as this fraction of the length over which the scene's light changes
+    /// ([`light_length`](crate::solver::light_length): its mean free path, shortened by lamps
+    /// close to surfaces where there are no adaptive rounds to resolve their pools), instead
+    /// of the scene file's ε or the area rule; 0.005 to 1. The
+    /// presets `preview` and `final` set it, so they place the same samples on a scene however
+    /// it was scaled and whatever ε its file asks for. [`Options::epsilon`] still wins;
+    /// [`Options::epsilon_scale`] multiplies it. `None` (the default preset): the scene file's
+    /// ε, else the area rule. A scene too open to have a free path takes the area rule.
+    pub epsilon_fraction: Option<f32>,
     /// α, the fall-off of the area weights w(d) = exp(−α d) (eq. 5), useful 0–16: 0 splits a
     /// cell evenly among all samples within 2ε; large α gives each cell to its nearest sample.
     pub alpha: f32,
@@ -106,6 +115,12 @@ pub const MAX_SPECULAR_RAYS: u32 = 4096;
 /// The most photons [`Options::photons`] may ask for.
 pub const MAX_PHOTONS: u64 = 1 << 30;
 
+/// [`Options::epsilon_fraction`] of the preview preset.
+pub const PREVIEW_EPSILON_FRACTION: f32 = 0.14;
+
+/// [`Options::epsilon_fraction`] of the final preset.
+pub const FINAL_EPSILON_FRACTION: f32 = 0.04;
+
 /// The default [`Options::specular_depth`].
 pub const DEFAULT_SPECULAR_DEPTH: u32 = 32;
 
@@ -117,6 +132,7 @@ impl Default for Options {
         Options {
             epsilon: None,
             epsilon_scale: 1.0,
+            epsilon_fraction: None,
             alpha: 8.0,
             zeta: 0.2,
             rounds: 2,
@@ -165,13 +181,14 @@ impl Options {
         self.cluster_threshold == 0.0
     }
 
-    /// Fast and rough: no adaptive rounds, few shadow rays, looser convergence (with
-    /// [`crate::RenderOptions::preview`]: few shadow rays and edge rays at the pixels). The
-    /// fastest setting measured within 2.5% MAE/mean of the path tracer on every shipped scene
-    /// (`docs/performance.md`, "Presets"); it keeps the scene's ε because the gallery is 3%
-    /// off at 1.2 ε, while simpler scenes allow [`Options::epsilon_scale`] 3 to 4.
+    /// Fast and rough: ε 0.14 of the scene's light length (not its file's ε), no adaptive
+    /// rounds, few shadow rays, looser convergence (with [`crate::RenderOptions::preview`]: few
+    /// shadow rays and edge rays at the pixels). The fastest setting measured within 2.5%
+    /// MAE/mean of the path tracer on every shipped scene (`docs/performance.md`, "Presets");
+    /// the gallery, whose lamps' pools ε itself must sample without rounds, set the lamp term.
     pub fn preview() -> Self {
         Options {
+            epsilon_fraction: Some(PREVIEW_EPSILON_FRACTION),
             rounds: 0,
             light_samples: 4,
             tolerance: 1e-2,
@@ -179,15 +196,15 @@ impl Options {
         }
     }
 
-    /// Slower and finer: samples at 0.6 of the scene's spacing, more rounds, a tighter ζ, more shadow rays,
-    /// tighter convergence, and a hierarchy five times tighter (with
+    /// Slower and finer: ε 0.04 of the scene's mean free path (not its file's ε), more rounds,
+    /// a tighter ζ, more shadow rays, tighter convergence, and a hierarchy five times tighter (with
     /// [`crate::RenderOptions::final_quality`]: more shadow and edge rays at the pixels). The
     /// most accurate setting measured within 10 × the default's time on every shipped scene
     /// (`docs/performance.md`, "Presets"). About three times the samples: a scene near the
     /// memory budget at the defaults will not fit.
     pub fn final_quality() -> Self {
         Options {
-            epsilon_scale: 0.6,
+            epsilon_fraction: Some(FINAL_EPSILON_FRACTION),
             rounds: 3,
             zeta: 0.1,
             light_samples: 64,
@@ -348,13 +365,27 @@ pub const KNOBS: &[Knob] = &[
     },
     Knob {
         name: "epsilon_scale",
-        help: "Multiplies the ε from the scene file or the automatic choice (not --epsilon), 1/16 \
-               to 16 [default: the preset's: 1, final 0.6]",
+        help: "Multiplies the ε from the scene file, the automatic choice or the preset's fraction (not --epsilon), 1/16 \
+               to 16 [default: 1]",
         value: Some("X"),
         parse: |o, t| number(t).map(|v| o.epsilon_scale = v),
         check: |o| match o.epsilon_scale {
             s if s.is_finite() && (0.0625..=16.0).contains(&s) => Ok(()),
             s => Err(format!("{s} must lie in [1/16, 16]")),
+        },
+    },
+    Knob {
+        name: "epsilon_fraction",
+        help: "ε as this fraction of the length over which the scene's light changes (its mean \
+               free path, shortened by lamps near surfaces), not the scene file's ε \
+               [default: the preset's: preview 0.14, final 0.04; none by default]",
+        value: Some("X"),
+        parse: |o, t| number(t).map(|v| o.epsilon_fraction = Some(v)),
+        check: |o| match o.epsilon_fraction {
+            Some(f) if !(f.is_finite() && (0.005..=1.0).contains(&f)) => {
+                Err(format!("{f} must lie in [0.005, 1]"))
+            }
+            _ => Ok(()),
         },
     },
     Knob {
@@ -528,6 +559,7 @@ mod tests {
         let values = [
             ("epsilon", "0.25"),
             ("epsilon_scale", "2"),
+            ("epsilon_fraction", "0.2"),
             ("zeta", "0.3"),
             ("alpha", "4"),
             ("rounds", "5"),
@@ -557,6 +589,10 @@ mod tests {
                 },
                 "epsilon_scale" => Options {
                     epsilon_scale: 2.0,
+                    ..base.clone()
+                },
+                "epsilon_fraction" => Options {
+                    epsilon_fraction: Some(0.2),
                     ..base.clone()
                 },
                 "zeta" => Options {
@@ -645,6 +681,8 @@ mod tests {
         for (name, bad) in [
             ("epsilon", "-1"),
             ("epsilon_scale", "17"),
+            ("epsilon_fraction", "0"),
+            ("epsilon_fraction", "1.5"),
             ("zeta", "0"),
             ("alpha", "NaN"),
             ("tolerance", "1"),
