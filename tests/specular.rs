@@ -492,3 +492,48 @@ fn specular_scenes_give_the_same_numbers_on_one_thread_and_two() {
         assert!(one == two, "{name}: 1 and 2 threads differ");
     }
 }
+
+#[test]
+fn a_light_seen_in_a_dim_mirror_is_not_a_penumbra_and_costs_no_second_look() {
+    // An empty room [0, 2]³ whose +x wall is a 90% mirror, lit by a square under the ceiling:
+    // nothing stands between any hit and the light or its image, so no hit lies in a
+    // penumbra and each traces at most 16 rays to the light and 16 to its image (the second
+    // look at penumbrae takes 4 × as many). A reflectance of 0.9 once counted as a tenth of
+    // shadow: every hit that saw the image was traced again (about 80 rays a camera ray on
+    // the shipped mirror room).
+    use common::mirror::{facing_down, v};
+    let mut b = Builder::default();
+    let grey = b.material(material("grey", 0.6, 0.0));
+    let lamp = b.material(material("lamp", 0.0, 4.0));
+    let mirror = b.material(specular("mirror", 0.0, 0.9, 0.0));
+    let (lo, hi) = (Vec3::ZERO, Vec3::splat(2.0));
+    b.room(lo, hi, grey, &["+x"]);
+    b.room(lo, hi, mirror, &["-x", "-y", "+y", "-z", "+z"]);
+    facing_down(&mut b, 1.98, [0.7, 1.3], [0.7, 1.3], lamp);
+    let scene = b.scene(camera(v(0.2, 1.0, 1.0), v(2.0, 0.9, 1.0), 32));
+    for backend in backends() {
+        let vis = backend.build(&scene).unwrap();
+        let solution = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |_| {
+            Control::Continue
+        })
+        .unwrap();
+        let (image, stats) = meshlight::render(
+            &scene,
+            &solution,
+            vis.as_ref(),
+            &meshlight::RenderOptions::default(),
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
+        assert!(image.mean() > 0.0, "{backend}");
+        let per_ray = stats.shadow_rays as f64 / stats.camera_rays as f64;
+        eprintln!(
+            "{backend}: {} shadow rays for {} camera rays: {per_ray:.1} each",
+            stats.shadow_rays, stats.camera_rays
+        );
+        assert!(
+            per_ray <= 32.0,
+            "{backend}: {per_ray:.1} shadow rays a camera ray"
+        );
+    }
+}

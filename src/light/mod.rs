@@ -26,6 +26,7 @@ use crate::visibility::{Ray, Segment, Visibility};
 
 pub(crate) mod leaving;
 mod spherical;
+mod window;
 
 /// Emitters subtending less than this (sr) from a receiver have their shadow rays drawn
 /// uniformly over their area: their rays weigh nearly alike, and from so far rounding would
@@ -60,6 +61,27 @@ struct Emitter {
     bounds: (Vec3, f32),
 }
 
+impl Emitter {
+    /// The same emitter made of `triangles` only (a planar one's part).
+    fn cut_to(&self, triangles: Vec<[Vec3; 3]>) -> Emitter {
+        let mut sum = 0.0;
+        let cumulative = triangles
+            .iter()
+            .map(|t| {
+                sum += 0.5 * f64::from((t[1] - t[0]).cross(t[2] - t[0]).length());
+                sum
+            })
+            .collect();
+        Emitter {
+            bounds: bounds(&triangles),
+            triangles,
+            cumulative,
+            facets: Vec::new(),
+            ..*self
+        }
+    }
+}
+
 /// Point `s` of a Fibonacci lattice of `count` in the unit square, shifted by `shift`
 /// (Cranley–Patterson): the first coordinate steps evenly, the second by the golden ratio.
 pub(crate) fn lattice(s: u32, count: u32, shift: (f64, f64)) -> (f64, f64) {
@@ -91,6 +113,8 @@ pub struct DirectLight {
     specular: Option<(Specular, Vec<Chain>)>,
     /// Per chain, the emitters as seen through it (their mirror images).
     images: Vec<Vec<Emitter>>,
+    /// Per reflector, its triangles: the outline an image is seen through.
+    windows: Vec<Vec<[Vec3; 3]>>,
     /// Whether the lights are reached straight too (not only through mirrors).
     straight: bool,
     /// The sun, where daylight with sunlight enters the scene.
@@ -150,7 +174,9 @@ const STRAIGHT: &[u32] = &[];
 pub struct Arrival {
     /// Irradiance, W/m², RGB.
     pub irradiance: DVec3,
-    /// Fraction of the unoccluded irradiance that arrives (1 fully lit, 0 in full shadow).
+    /// Fraction of the unoccluded irradiance whose shadow rays get through (1 fully lit, 0 in
+    /// full shadow); a mirror's or a pane's reflectance or transmittance along the way dims
+    /// the irradiance but is no shadow.
     pub visible: f32,
     /// The form factor, as visible, from the point to the emitters that do not reflect:
     /// the part of its hemisphere that sends light but takes none back.
@@ -208,6 +234,7 @@ impl DirectLight {
             lift: crate::visibility::lift(scene),
             specular: None,
             images: Vec::new(),
+            windows: Vec::new(),
             straight: true,
             sun,
         }
@@ -307,6 +334,17 @@ impl DirectLight {
                                 reflects: e.reflects,
                             }
                         })
+                        .collect()
+                })
+                .collect();
+            light.windows = spec
+                .reflectors
+                .iter()
+                .map(|r| {
+                    let range = &scene.surfaces[r.surface as usize].triangles;
+                    scene.triangles[range.start as usize..range.end as usize]
+                        .iter()
+                        .map(|t| t.vertices)
                         .collect()
                 })
                 .collect();
@@ -425,23 +463,32 @@ impl DirectLight {
     ) -> Result<u64> {
         // Per receiver: the light that arrives, and what would arrive with nothing in the way.
         let mut arrived = vec![DVec3::ZERO; points.len()];
+        // What would arrive with nothing in the way, and the part of it whose rays got
+        // through (a mirror's or a pane's reflectance along the way is not a shadow).
         let mut unoccluded = vec![0.0f64; points.len()];
-        let point_queries = self.point_lights_at(vis, points, &mut arrived, &mut unoccluded)?;
+        let mut open = vec![0.0f64; points.len()];
+        let point_queries =
+            self.point_lights_at(vis, points, &mut arrived, (&mut unoccluded, &mut open))?;
         let mut dark_emitters = vec![0.0f64; points.len()];
         let area_queries = self.area_lights_at(
             vis,
             (points, ids, seed),
             &mut arrived,
-            &mut unoccluded,
+            (&mut unoccluded, &mut open),
             &mut dark_emitters,
         )?;
-        let sun_queries = self.sun_at(vis, (points, ids, seed), &mut arrived, &mut unoccluded)?;
+        let sun_queries = self.sun_at(
+            vis,
+            (points, ids, seed),
+            &mut arrived,
+            (&mut unoccluded, &mut open),
+        )?;
         for (r, o) in out.iter_mut().enumerate() {
             let (h, full) = (arrived[r], unoccluded[r]);
             *o = Arrival {
                 irradiance: h,
                 visible: if full > 0.0 {
-                    (h.element_sum() / full).clamp(0.0, 1.0) as f32
+                    (open[r] / full).clamp(0.0, 1.0) as f32
                 } else {
                     0.0
                 },
@@ -459,7 +506,7 @@ impl DirectLight {
         vis: &dyn Visibility,
         (points, ids, seed): (&[(Vec3, Vec3)], &[u32], u64),
         arrived: &mut [DVec3],
-        unoccluded: &mut [f64],
+        (unoccluded, open): (&mut [f64], &mut [f64]),
     ) -> Result<u64> {
         let Some(sun) = self.sun.filter(|_| self.straight) else {
             return Ok(0);
@@ -522,6 +569,9 @@ impl DirectLight {
         }
         for (&(r, e), share) in lit.iter().zip(&shares) {
             arrived[r] += *share * e;
+            if share.max_element() > 0.0 {
+                open[r] += 3.0 * e;
+            }
         }
         Ok(rays.len() as u64)
     }
@@ -534,7 +584,7 @@ impl DirectLight {
         vis: &dyn Visibility,
         points: &[(Vec3, Vec3)],
         arrived: &mut [DVec3],
-        unoccluded: &mut [f64],
+        (unoccluded, open): (&mut [f64], &mut [f64]),
     ) -> Result<u64> {
         let mut paths = Vec::new();
         let mut lit = Vec::new();
@@ -572,6 +622,7 @@ impl DirectLight {
         for (&(r, contribution), share) in lit.iter().zip(&shares) {
             if share.max_element() > 0.0 {
                 arrived[r] += contribution * *share;
+                open[r] += contribution.element_sum();
             }
         }
         Ok(queries)
@@ -587,7 +638,7 @@ impl DirectLight {
         vis: &dyn Visibility,
         (points, ids, seed): (&[(Vec3, Vec3)], &[u32], u64),
         arrived: &mut [DVec3],
-        unoccluded: &mut [f64],
+        (unoccluded, open): (&mut [f64], &mut [f64]),
         dark_emitters: &mut [f64],
     ) -> Result<u64> {
         let ne = self.emitters.len();
@@ -658,9 +709,12 @@ impl DirectLight {
         } = tally;
         let mut shares = vec![DVec3::ZERO; paths.len()];
         let queries = self.shares(vis, &paths, &mut shares)?;
+        // Per slot, Σ weights of the rays that got through.
+        let mut through = vec![0.0f64; weights.len()];
         for (&(slot, weight), share) in rays.iter().zip(&shares) {
             if share.max_element() > 0.0 {
                 weights[slot].1 += weight * *share;
+                through[slot] += weight;
             }
         }
         for r in 0..points.len() {
@@ -669,6 +723,7 @@ impl DirectLight {
                 if all > 0.0 {
                     arrived[r] += analytic[slot] * (visible / all);
                     dark_emitters[r] += factor[slot] * (visible.x / all);
+                    open[r] += analytic[slot].element_sum() * (through[slot] / all);
                 }
             }
         }
@@ -691,6 +746,25 @@ impl DirectLight {
             return self.facet_rays(emitter, seen, rng, tally, unoccluded);
         }
         let (x, n) = (seen.x, seen.n);
+        // An image seen through one mirror: only the part its outline lets through.
+        let clipped;
+        let emitter = match (seen.chain, &self.specular) {
+            (&[k], Some((spec, _))) if (k as usize) < self.windows.len() => {
+                let r = &spec.reflectors[k as usize];
+                let pieces = window::through(
+                    &emitter.triangles,
+                    x,
+                    &self.windows[k as usize],
+                    (r.normal, r.offset),
+                );
+                if pieces.is_empty() {
+                    return;
+                }
+                clipped = emitter.cut_to(pieces);
+                &clipped
+            }
+            _ => emitter,
+        };
         // Emitters light only what lies in front of them.
         let height = emitter.normal.dot(x) - emitter.offset;
         if height <= 0.0 {
