@@ -169,12 +169,22 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
                     if let Some(h) = l.lamp_clearance {
                         println!("lamps         the nearest surface {h:.6} from a lamp");
                     }
+                    // The ε each preset would solve at, as the solve chooses it.
+                    let epsilon = |preset: meshlight::Preset| {
+                        meshlight::solver::choose_epsilon_for(
+                            &scene,
+                            vis.as_ref(),
+                            &sides,
+                            &preset.options(),
+                        )
+                        .map(|(e, _)| e)
+                    };
                     println!(
-                        "light length  {:.6}: preview's ε {:.6}; final's {:.6} (the free path's: \
-                         its rounds resolve lamps' pools)",
+                        "light length  {:.6}: preview's ε {:.6}; final's {:.6} (from the free \
+                         path: its rounds resolve lamps' pools)",
                         l.length,
-                        l.length * f64::from(meshlight::solver::PREVIEW_EPSILON_FRACTION),
-                        l.free_path * f64::from(meshlight::solver::FINAL_EPSILON_FRACTION)
+                        epsilon(meshlight::Preset::Preview)?,
+                        epsilon(meshlight::Preset::Final)?
                     );
                 }
                 None => println!(

@@ -97,7 +97,7 @@ pub fn solve_with_progress(
             eprintln!(
                 "meshlight: ε = {epsilon:.4}: {} of the length over which the scene's light changes, {:.3} (its mean free path {:.3}{lamps}); a scene file's ε is for the default preset",
                 options.epsilon_fraction.unwrap_or(0.0) * options.epsilon_scale,
-                if options.rounds == 0 { l.length } else { l.free_path },
+                l.for_rounds(options.rounds),
                 l.free_path,
             );
         }

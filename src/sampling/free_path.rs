@@ -130,6 +130,18 @@ pub struct LightLength {
     pub length: f64,
 }
 
+impl LightLength {
+    /// The length ε is taken from with `rounds` adaptive rounds: a lamp's pool is resolved by
+    /// the rounds where there are any; without them ε itself must follow it.
+    pub fn for_rounds(&self, rounds: u32) -> f64 {
+        if rounds == 0 {
+            self.length
+        } else {
+            self.free_path
+        }
+    }
+}
+
 /// The length over which the scene's light changes (see [`LightLength`]), or `None` for a scene
 /// too open to have a free path.
 pub fn light_length(

@@ -329,13 +329,7 @@ fn epsilon_over(
             let area = area_of(scene, &sides);
             match light_length(scene, vis, &sides)? {
                 Some(l) => {
-                    // A lamp's pool is resolved by the adaptive rounds where there are any;
-                    // without them ε itself follows it.
-                    let length = if options.rounds == 0 {
-                        l.length
-                    } else {
-                        l.free_path
-                    };
+                    let length = l.for_rounds(options.rounds);
                     // However short the length, the preset leaves room for its rounds: at most
                     // an eighth of max_samples to start with.
                     let floor = (0.7 * area / (options.max_samples as f64 / 8.0).max(1.0)).sqrt();
