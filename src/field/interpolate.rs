@@ -6,7 +6,7 @@
 //! reaches a point in sight, its nearest visible sample. Shared by the camera's hits, the
 //! points specular chains end at, and the grids.
 
-use glam::{DVec2, Vec3};
+use glam::{DVec2, Vec2, Vec3};
 
 use super::Field;
 use crate::error::Result;
@@ -47,6 +47,9 @@ pub(crate) struct Interpolator<'a> {
     lift: f32,
     /// Largest kernel support among each side's samples (0: the side has none).
     support: Vec<f32>,
+    /// Per sample: whether nothing crosses its side's band within its kernel's support, so
+    /// that any point its kernel reaches sees it along the side (no query).
+    clear: Vec<bool>,
     /// Whether weights are those of a local-linear fit (see [`local_linear`]); plain kernel
     /// weights (all positive) where they enter the solve as transport.
     linear: bool,
@@ -59,11 +62,24 @@ impl<'a> Interpolator<'a> {
         for (&side, &d) in s.side.iter().zip(&s.radius) {
             support[side as usize] = support[side as usize].max(SUPPORT * d);
         }
+        // A segment from a point within a kernel's support to its sample lies in the support's
+        // disc: nothing crossing the band there, nothing can block it.
+        let obstruction = field.layout.obstruction();
+        let maps = field.layout.maps();
+        let clear = (0..s.len())
+            .map(|k| {
+                let side = s.side[k];
+                let uv = maps[surface_of(side) as usize].to_2d(s.position[k]);
+                let r = Vec2::splat(SUPPORT * s.radius[k]);
+                !obstruction.may_block(side, uv - r, uv + r)
+            })
+            .collect();
         Interpolator {
             field,
             vis,
             lift: crate::visibility::lift(scene),
             support,
+            clear,
             linear: true,
         }
     }
@@ -124,6 +140,7 @@ impl<'a> Interpolator<'a> {
         let mut ranges = Vec::with_capacity(sites.len());
         let mut segments = Vec::new();
         let mut near = Vec::new();
+        let obstruction = self.field.layout.obstruction();
         for site in sites {
             let map = &self.field.layout.maps()[surface_of(site.side) as usize];
             let from = site.point + self.lift * site.normal;
@@ -135,14 +152,17 @@ impl<'a> Interpolator<'a> {
                 .within(s, site.side, uv, reach, &mut near);
             near.sort_unstable_by_key(|&(k, _)| k);
             let start = candidates.len();
-            let test = self.field.layout.obstruction().is_obstructed(site.side);
             for &(k, d2) in &near {
                 let r = SUPPORT * s.radius[k as usize];
                 let q = d2 / (r * r);
                 if q < 1.0 {
                     candidates.push((k, (1.0 - q).powi(3)));
-                    // On sides nothing stands on, every sample is in sight: no query.
-                    segments.push(test.then(|| Segment {
+                    // Where nothing stands within the kernel, or across the segment's box,
+                    // the sample is in sight: no query.
+                    let to = s.uv[k as usize];
+                    let open = self.clear[k as usize]
+                        || !obstruction.may_block(site.side, uv.min(to), uv.max(to));
+                    segments.push((!open).then(|| Segment {
                         a: from,
                         b: s.position[k as usize] + self.lift * s.normal[k as usize],
                     }));
