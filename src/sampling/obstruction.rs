@@ -74,7 +74,7 @@ impl Obstruction {
                 let mut found = false;
                 let mut seen: Vec<u32> = Vec::new();
                 let mut prints: Option<Vec<(Vec2, Vec2)>> = Some(Vec::new());
-                for x in klo.x..=khi.x {
+                'cells: for x in klo.x..=khi.x {
                     for y in klo.y..=khi.y {
                         for z in klo.z..=khi.z {
                             let Some(list) = grid.get(&IVec3::new(x, y, z)) else {
@@ -102,14 +102,16 @@ impl Obstruction {
                                         continue;
                                     }
                                     seen.push(t);
-                                    if let Some(list) = prints.as_mut() {
-                                        if list.len() == MAX_FOOTPRINTS {
-                                            prints = None;
-                                        } else {
-                                            let part = in_band(&tri.vertices, h, reach);
-                                            list.push(footprint(map, &part, lift));
-                                        }
+                                    let Some(list) = prints.as_mut() else {
+                                        break 'cells;
+                                    };
+                                    if list.len() == MAX_FOOTPRINTS {
+                                        // Too many to scan: every segment is asked.
+                                        prints = None;
+                                        break 'cells;
                                     }
+                                    let part = in_band(&tri.vertices, h, reach);
+                                    list.push(footprint(map, &part, lift));
                                 }
                             }
                         }
