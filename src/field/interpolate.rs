@@ -65,13 +65,10 @@ impl<'a> Interpolator<'a> {
         // A segment from a point within a kernel's support to its sample lies in the support's
         // disc: nothing crossing the band there, nothing can block it.
         let obstruction = field.layout.obstruction();
-        let maps = field.layout.maps();
         let clear = (0..s.len())
             .map(|k| {
-                let side = s.side[k];
-                let uv = maps[surface_of(side) as usize].to_2d(s.position[k]);
                 let r = Vec2::splat(SUPPORT * s.radius[k]);
-                !obstruction.may_block(side, uv - r, uv + r)
+                !obstruction.may_block(s.side[k], s.uv[k] - r, s.uv[k] + r)
             })
             .collect();
         Interpolator {

@@ -23,10 +23,9 @@ const MAX_FOOTPRINTS: usize = 256;
 /// sides.
 #[derive(Clone, Debug)]
 pub struct Obstruction {
-    obstructed: Vec<bool>,
     /// Per side: the (u, v) boxes, in its surface's frame, of the parts of the triangles
     /// crossing its band (grown by the lift), or none when there are more than
-    /// [`MAX_FOOTPRINTS`]. Empty for sides nothing crosses.
+    /// [`MAX_FOOTPRINTS`]. Empty for sides nothing crosses, which are the unobstructed ones.
     footprints: Vec<Option<Vec<(Vec2, Vec2)>>>,
     lift: f32,
 }
@@ -52,7 +51,6 @@ impl Obstruction {
                 }
             }
         }
-        let mut obstructed = vec![false; 2 * maps.len()];
         let mut footprints = vec![Some(Vec::new()); 2 * maps.len()];
         for (s, map) in maps.iter().enumerate() {
             let surface = &scene.surfaces[s];
@@ -71,7 +69,6 @@ impl Obstruction {
                 );
                 let base = normal.dot(map.origin);
                 let (klo, khi) = (key(blo), key(bhi));
-                let mut found = false;
                 let mut seen: Vec<u32> = Vec::new();
                 let mut prints: Option<Vec<(Vec2, Vec2)>> = Some(Vec::new());
                 'cells: for x in klo.x..=khi.x {
@@ -96,7 +93,6 @@ impl Obstruction {
                                 let (hmin, hmax) =
                                     (h[0].min(h[1]).min(h[2]), h[0].max(h[1]).max(h[2]));
                                 if hmax > 0.0 && hmin < reach {
-                                    found = true;
                                     // A triangle listed in several cells is one footprint.
                                     if seen.contains(&t) {
                                         continue;
@@ -117,36 +113,30 @@ impl Obstruction {
                         }
                     }
                 }
-                let side = side_of(s as u32, back) as usize;
-                obstructed[side] = found;
-                footprints[side] = prints;
+                footprints[side_of(s as u32, back) as usize] = prints;
             }
         }
-        Obstruction {
-            obstructed,
-            footprints,
-            lift,
-        }
+        Obstruction { footprints, lift }
     }
 
     /// Whether something crossing the side's band meets the (u, v) box `lo`..`hi` of its
     /// surface's frame: a segment along the side (lifted off it) whose ends lie in that box
     /// can be blocked only then. Conservative: any side whose footprints were not kept.
     pub fn may_block(&self, side: Side, lo: Vec2, hi: Vec2) -> bool {
-        if !self.is_obstructed(side) {
-            return false;
-        }
         match self.footprints.get(side as usize) {
             Some(Some(prints)) => prints
                 .iter()
                 .any(|(plo, phi)| plo.cmple(hi).all() && phi.cmpge(lo).all()),
-            _ => true,
+            Some(None) => true,
+            None => false,
         }
     }
 
     /// Whether points of this side may hide from each other.
     pub fn is_obstructed(&self, side: Side) -> bool {
-        self.obstructed.get(side as usize).copied().unwrap_or(false)
+        self.footprints
+            .get(side as usize)
+            .is_some_and(|p| p.as_ref().is_none_or(|p| !p.is_empty()))
     }
 
     /// The segment between a point of a side and a sample, both lifted off the side.
