@@ -80,6 +80,7 @@ impl<'a> Basis<'a> {
             closed: &solution.closed,
             dark_emitters: &basis.dark_emitters,
             specular: solution.specular.as_ref(),
+            regather: None,
         };
         let settings = basis.settings();
         let cx = Context {
@@ -164,6 +165,7 @@ impl<'a> Basis<'a> {
             closed: &solution.closed,
             dark_emitters: &self.dark_emitters,
             specular: solution.specular.as_ref(),
+            regather: None,
         };
         let mut report = |_: Tick| {
             if stop() {

@@ -30,6 +30,7 @@ use super::normalise::row_scale;
 use super::pipeline::with_pool;
 use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
+use super::warm::{self, Regather};
 use crate::progress::Control;
 
 /// Visibility already known: row j holds, once sample j has shot, which samples see it.
@@ -150,6 +151,9 @@ pub(crate) fn shoot(
         {
             stats.stop = StopReason::Stopped;
             return Ok(stats);
+        }
+        if let Some(regather) = state.regather {
+            stats.queries += gather_new(state, vis, lift, regather, threads)?;
         }
         shots(
             state,
@@ -336,6 +340,68 @@ fn shots(
         stats.shots += 1;
     }
     Ok(())
+}
+
+/// Each new sample's own inter-reflected light (`warm::Regather`): the light every sample has
+/// shot so far (`warm::shot`), through the form factors and rays its shots take, row-scaled as
+/// they are, and by way of specular surfaces. The visibility queries.
+fn gather_new(
+    state: &mut State,
+    vis: &dyn Visibility,
+    lift: f32,
+    regather: Regather,
+    threads: usize,
+) -> Result<u64> {
+    let samples = state.samples;
+    let shot = warm::shot(state.irradiance, state.unshot, state.reflectance);
+    let shooters: Vec<Shooter> = (0..samples.len())
+        .filter(|&j| shot[j] != glam::DVec3::ZERO)
+        .map(|j| Shooter::of(samples, state.maps, j))
+        .collect();
+    let row_scale: &[f32] = state.row_scale;
+    let mut gathered = vec![(glam::DVec3::ZERO, 0u64); samples.len() - regather.first];
+    crate::parallel::for_chunks(&mut gathered, 64, threads, |first, chunk| {
+        let (mut segments, mut found) = (Vec::new(), Vec::new());
+        for (out, k) in chunk.iter_mut().zip(regather.first + first..) {
+            segments.clear();
+            found.clear();
+            for shooter in &shooters {
+                let j = shooter.index as usize;
+                if j == k {
+                    continue;
+                }
+                if let Some(f) = shooter.factor_to(samples, k) {
+                    segments.push(segment(samples, lift, j, k));
+                    found.push((j, f));
+                }
+            }
+            let mut blocked = vec![false; segments.len()];
+            vis.occluded(&segments, &mut blocked)?;
+            let mut h = glam::DVec3::ZERO;
+            for (&(j, f), &blocked) in found.iter().zip(&blocked) {
+                if !blocked {
+                    h += shot[j] * f64::from(f);
+                }
+            }
+            *out = (h * f64::from(row_scale[k]), segments.len() as u64);
+        }
+        Ok(())
+    })?;
+    let mut queries = 0;
+    for (k, &(h, q)) in (regather.first..).zip(&gathered) {
+        let through = state
+            .specular
+            .map_or(glam::DVec3::ZERO, |g| g.row_times(k, &shot));
+        regather.apply(
+            state.irradiance,
+            state.unshot,
+            state.reflectance,
+            k,
+            h + through,
+        );
+        queries += q;
+    }
+    Ok(queries)
 }
 
 /// Form factors from every sample that sees sample `j` to `j`'s region: (receiver, F).

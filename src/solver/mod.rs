@@ -510,6 +510,7 @@ fn solve_with(
         reporter: Reporter::new(progress),
         ranks,
         light_scale: glam::DVec3::ONE,
+        interpolated: Vec::new(),
         entering: crate::daylight::entering::Entering::of(scene, SKY_RAYS),
     };
 

@@ -47,6 +47,9 @@ pub(super) struct Solve<'a> {
     pub(super) light_scale: DVec3,
     /// The daylight entering, where the scene has a sky.
     pub(super) entering: Option<crate::daylight::entering::Entering<'a>>,
+    /// This round's new samples' inter-reflected irradiance as their warm start interpolated
+    /// it (see `warm::Regather`); empty in the first round.
+    pub(super) interpolated: Vec<DVec3>,
 }
 
 /// Samples an adaptive step (or the initial placement) added.
@@ -312,7 +315,7 @@ impl<'a> Solve<'a> {
         queries += self.specular_light(solution, round, first_new, at)?;
         queries += self.daylight(solution, round, at)?;
         let (scene, vis, alpha) = (self.scene, self.vis, self.options.alpha);
-        warm::start(
+        self.interpolated = warm::start(
             scene,
             solution,
             vis,
@@ -610,6 +613,10 @@ impl<'a> Solve<'a> {
             closed: &solution.closed,
             dark_emitters: &dark_emitters,
             specular: solution.specular.as_ref(),
+            regather: (round > 0 && !self.interpolated.is_empty()).then(|| warm::Regather {
+                first: n - self.interpolated.len(),
+                interpolated: &self.interpolated,
+            }),
         };
         let settings = Settings {
             exec: self.exec(),

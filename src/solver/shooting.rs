@@ -29,6 +29,8 @@ pub(crate) struct State<'a> {
     pub dark_emitters: &'a [f64],
     /// Light by way of specular surfaces, shot beside the links.
     pub specular: Option<&'a super::specular::Transfer>,
+    /// A round's new samples, whose inter-reflected light is gathered before shooting.
+    pub regather: Option<super::warm::Regather<'a>>,
 }
 
 /// Settings of one solve.

@@ -4,7 +4,8 @@
 //! interpolated from its old neighbours, and its unshot radiosity is the difference between
 //! that and the shot radiosity interpolated at its place. Shooting then only carries the
 //! corrections the new samples bring (mostly sharper direct light), not the whole solution
-//! again.
+//! again. Where the round links its samples, the interpolated indirect light is only a
+//! stand-in: the shooters gather each new sample's own before they shoot (see [`Regather`]).
 
 use glam::DVec3;
 
@@ -47,8 +48,52 @@ pub(crate) fn exact_beyond_direct(solution: &Solution, k: usize) -> DVec3 {
         })
 }
 
+/// A round's new samples, whose inter-reflected light the warm start interpolated from their
+/// old neighbours: the solvers gather each one's own from the light every sample has shot so
+/// far (the radiosity it reflects, less what it has not shot), along the same form factors
+/// and visibility the shots take, and put it in place of the interpolated light, the
+/// difference joining the sample's unshot radiosity. Interpolated, a sample added beside
+/// something that hides part of the room from it (the strip of a pedestal's top a sculpture
+/// overhangs, a wall just under a picture frame) only ever had its neighbours' light, however
+/// many samples a round added there.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Regather<'a> {
+    /// The first new sample (they run to the end).
+    pub first: usize,
+    /// Each new sample's inter-reflected irradiance as the warm start interpolated it.
+    pub interpolated: &'a [DVec3],
+}
+
+impl Regather<'_> {
+    /// Puts each new sample's gathered inter-reflected irradiance (`gathered(k)`) in place of
+    /// its interpolated one.
+    pub(crate) fn apply(
+        &self,
+        irradiance: &mut [DVec3],
+        unshot: &mut [DVec3],
+        reflectance: &[DVec3],
+        k: usize,
+        gathered: DVec3,
+    ) {
+        if k >= self.first {
+            let change = gathered - self.interpolated[k - self.first];
+            irradiance[k] += change;
+            unshot[k] += reflectance[k] * change;
+        }
+    }
+}
+
+/// The radiosity each sample has shot so far (what it reflects, less what it has not shot):
+/// what a [`Regather`] gathers.
+pub(crate) fn shot(irradiance: &[DVec3], unshot: &[DVec3], reflectance: &[DVec3]) -> Vec<DVec3> {
+    (0..irradiance.len())
+        .map(|k| reflectance[k] * irradiance[k] - unshot[k])
+        .collect()
+}
+
 /// Extends the solution's per-sample arrays to the new samples `first_new..` and sets their
 /// unshot radiosity for a (warm) start: see the module doc. Each rank a run of the new samples.
+/// Returns each new sample's interpolated inter-reflected irradiance (for a [`Regather`]).
 pub(crate) fn start(
     scene: &Scene,
     solution: &mut Solution,
@@ -57,13 +102,13 @@ pub(crate) fn start(
     arrivals: &[Arrival],
     alpha: f32,
     exec: crate::exec::Exec,
-) -> Result<()> {
+) -> Result<Vec<DVec3>> {
     let n = solution.field.samples.len();
     let epsilon = solution.field.layout.epsilon();
-    // (irradiance, unshot, radiosity) of each new sample.
-    let mut out = vec![(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); n - first_new];
+    // (irradiance, unshot, radiosity, interpolated indirect irradiance) of each new sample.
+    let mut out = vec![(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); n - first_new];
     let shared: &Solution = solution;
-    let each = |first: usize, chunk: &mut [(DVec3, DVec3, DVec3)]| {
+    let each = |first: usize, chunk: &mut [(DVec3, DVec3, DVec3, DVec3)]| {
         let samples = &shared.field.samples;
         let mut near = Vec::new();
         let r = 2.0 * epsilon;
@@ -110,7 +155,12 @@ pub(crate) fn start(
                 shot /= wsum;
             }
             let h = arrivals[k - first_new].irradiance + indirect + exact_beyond_direct(shared, k);
-            *o = (h, rho * h - shot, emission(scene, samples, k) + rho * h);
+            *o = (
+                h,
+                rho * h - shot,
+                emission(scene, samples, k) + rho * h,
+                indirect,
+            );
         }
         Ok(())
     };
@@ -120,12 +170,13 @@ pub(crate) fn start(
         256,
         |first, out, _: &_| each(first, out),
         &mut |_| crate::progress::Control::Continue,
-        |(h, u, b)| [h.x, h.y, h.z, u.x, u.y, u.z, b.x, b.y, b.z],
+        |(h, u, b, i)| [h.x, h.y, h.z, u.x, u.y, u.z, b.x, b.y, b.z, i.x, i.y, i.z],
         |v| {
             (
                 DVec3::new(v[0], v[1], v[2]),
                 DVec3::new(v[3], v[4], v[5]),
                 DVec3::new(v[6], v[7], v[8]),
+                DVec3::new(v[9], v[10], v[11]),
             )
         },
     )?;
@@ -135,11 +186,13 @@ pub(crate) fn start(
     solution.unshot.reserve_exact(out.len());
     solution.field.radiosity.reserve_exact(out.len());
     solution.field.direct.extend_from_slice(arrivals);
-    for (h, unshot, radiosity) in out {
+    let mut interpolated = Vec::with_capacity(out.len());
+    for (h, unshot, radiosity, indirect) in out {
         solution.field.irradiance.push(h);
         solution.unshot.push(unshot);
         solution.field.radiosity.push(radiosity);
+        interpolated.push(indirect);
     }
     debug_assert_eq!(solution.field.irradiance.len(), n);
-    Ok(())
+    Ok(interpolated)
 }

@@ -34,6 +34,7 @@ use super::normalise::row_scale;
 use super::pipeline::{with_pool, Pool};
 use super::shooting::{nothing_to_shoot, unshot_power, Settings, State, Tick};
 use super::stats::{ShootStats, StopReason};
+use super::warm::{self, Regather};
 use crate::distributed::{gather_one, owners, sum_over, Ranks};
 use crate::error::Result;
 use crate::progress::Control;
@@ -42,6 +43,10 @@ use crate::visibility::Visibility;
 /// Shooters darker than this fraction of the mean radiosity are weighed as this bright in the
 /// error bound: their light may grow in later sweeps (a room lit through a doorway).
 const DARK_WEIGHT: f64 = 0.2;
+
+/// A round whose warm start left less than the tolerance unshot links its samples to gather
+/// its new samples' light (`warm::Regather`) only if they are at least this share of all.
+const REGATHER_SHARE: f64 = 0.01;
 
 /// Sweeps at most, unless `max_shots` says otherwise.
 pub(crate) const MAX_SWEEPS: u64 = 10_000;
@@ -95,7 +100,12 @@ pub(crate) fn shoot(
         .sum();
     stats.initial_unshot_fraction = unshot / emitted;
     stats.unshot_fraction = stats.initial_unshot_fraction;
-    if stats.unshot_fraction < settings.tolerance {
+    // A round that adds only a handful of samples is not worth linking everything for their
+    // gather: where nothing else needs the links, they keep their interpolated light.
+    let regathers = state
+        .regather
+        .is_some_and(|r| (n - r.first) as f64 >= REGATHER_SHARE * n as f64);
+    if stats.unshot_fraction < settings.tolerance && !regathers {
         return Ok(stats);
     }
 
@@ -488,6 +498,10 @@ fn sweep(
                 rows = sums;
             }
         }
+        if let Some(regather) = state.regather {
+            stats.exchanged_bytes +=
+                regather_once(&mut sweeps, &mut groups, state, regather, &set)?;
+        }
         let max_sweeps = if settings.max_shots == u64::MAX {
             MAX_SWEEPS
         } else {
@@ -615,6 +629,42 @@ fn row_sums(
             .map(|(&sum, &scale)| sum * f64::from(scale))
             .collect()
     }))
+}
+
+/// One sweep of the light every sample has shot so far (`warm::shot`), row-scaled as the
+/// shots are, and by way of specular surfaces: each new sample's own inter-reflected light,
+/// in place of the one its warm start interpolated (`warm::Regather`). The bytes exchanged.
+fn regather_once(
+    sweeps: &mut Sweeps,
+    groups: &mut Vec<Group>,
+    state: &mut State,
+    regather: Regather,
+    set: &dyn Fn(&[DVec3], &[f32]),
+) -> Result<u64> {
+    let tree = sweeps.tree;
+    let shot = warm::shot(state.irradiance, state.unshot, state.reflectance);
+    set(&shot, state.row_scale);
+    let bytes = sweeps.run(groups)?;
+    let mut gathered = vec![DVec3::ZERO; state.samples.len()];
+    for group in groups.iter() {
+        let first = first_member(tree, group.root);
+        for (p, &h) in group.delivered.iter().enumerate() {
+            gathered[tree.order[first + p] as usize] = h;
+        }
+    }
+    for (k, &h) in gathered.iter().enumerate().skip(regather.first) {
+        let through = state
+            .specular
+            .map_or(DVec3::ZERO, |g| g.row_times(k, &shot));
+        regather.apply(
+            state.irradiance,
+            state.unshot,
+            state.reflectance,
+            k,
+            h + through,
+        );
+    }
+    Ok(bytes)
 }
 
 /// Why the sweeps end before the next, if they do: diverged, converged (the unshot power
