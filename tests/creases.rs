@@ -315,15 +315,7 @@ fn ball_on_a_pedestal() -> Scene {
     let white = b.material(material("white", 0.7, 0.0));
     b.room(Vec3::ZERO, Vec3::new(4.0, 4.5, 4.0), white, &[]);
     b.solid(PEDESTAL.0, PEDESTAL.1, white);
-    let centre = Vec3::new(2.0, 1.32, 2.0);
-    for [p, q, r] in icosphere(2) {
-        let base = b.mesh.positions.len() as u32;
-        b.mesh
-            .positions
-            .extend([centre + 0.32 * p, centre + 0.32 * q, centre + 0.32 * r]);
-        b.mesh.triangles.push([base, base + 1, base + 2]);
-        b.mesh.triangle_materials.push(white);
-    }
+    b.ball(Vec3::new(2.0, 1.32, 2.0), 0.32, 2, white);
     b.point_lights.push(meshlight::scene::PointLight {
         position: LAMP,
         intensity: Vec3::splat(40.0),
@@ -338,64 +330,6 @@ fn ball_on_a_pedestal() -> Scene {
 const PEDESTAL: (Vec3, Vec3) = (Vec3::new(1.7, 0.0, 1.7), Vec3::new(2.3, 1.0, 2.3));
 /// The lamp, 0.2 m under the ceiling, offset from the pedestal as in the gallery.
 const LAMP: Vec3 = Vec3::new(1.43, 4.3, 1.23);
-
-/// The unit icosphere's triangles, each face cut in four `detail` times, counter-clockwise
-/// seen from outside.
-fn icosphere(detail: u32) -> Vec<[Vec3; 3]> {
-    let t = (1.0 + 5f32.sqrt()) / 2.0;
-    let v = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .map(|(x, y, z)| Vec3::new(x, y, z).normalize());
-    let faces = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let mut out: Vec<[Vec3; 3]> = faces.iter().map(|f| f.map(|i| v[i])).collect();
-    for _ in 0..detail {
-        out = out
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let (ab, bc, ca) = (
-                    (a + b).normalize(),
-                    (b + c).normalize(),
-                    (c + a).normalize(),
-                );
-                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
-            })
-            .collect();
-    }
-    out
-}
 
 #[test]
 fn the_strip_a_ball_overhangs_gets_its_own_inter_reflected_light() {
