@@ -65,8 +65,8 @@ pub(crate) struct Regather<'a> {
 }
 
 impl Regather<'_> {
-    /// Puts each new sample's gathered inter-reflected irradiance (`gathered(k)`) in place of
-    /// its interpolated one.
+    /// Puts sample k's gathered inter-reflected irradiance in place of the one its warm start
+    /// interpolated (an old sample keeps its own).
     pub(crate) fn apply(
         &self,
         irradiance: &mut [DVec3],
