@@ -3,7 +3,9 @@
 //! average), so interpolation alone reads it several per cent too bright. The render gathers
 //! the light at hits near another surface; these tests measure bands a few centimetres wide
 //! along a box's foot and along a room's ceiling–wall edge, and check that interpolation alone
-//! misses them (the tests would fail without the gather).
+//! misses them (the tests would fail without the gather). And a strip of a pedestal's top that a
+//! ball overhangs, lit past the ball: the adaptive samples there must carry its own
+//! inter-reflected light, not their neighbours' under the ball.
 
 mod common;
 
