@@ -61,20 +61,25 @@ fn seen(scene: &Scene, vis: &dyn Visibility) -> Vec<Option<Vec3>> {
         .collect()
 }
 
-/// Our mean over the pixels `chosen` picks divided by the reference's, minus 1; and how many.
+/// Our mean over the pixels whose seen point `chosen` picks divided by the reference's, minus
+/// 1; and how many.
 fn band(
     ours: &Image,
     reference: &Image,
     points: &[Option<Vec3>],
     chosen: impl Fn(Vec3) -> bool,
 ) -> (f64, usize) {
+    let mask: Vec<bool> = points.iter().map(|q| q.is_some_and(&chosen)).collect();
+    pixels(ours, reference, &mask)
+}
+
+/// Our mean over the pixels `mask` picks divided by the reference's, minus 1; and how many.
+fn pixels(ours: &Image, reference: &Image, mask: &[bool]) -> (f64, usize) {
     let (mut a, mut b, mut n) = (0.0f64, 0.0f64, 0usize);
-    for (p, q) in points.iter().enumerate() {
-        if q.is_some_and(&chosen) {
-            a += f64::from(ours.pixels[p].element_sum());
-            b += f64::from(reference.pixels[p].element_sum());
-            n += 1;
-        }
+    for (p, _) in mask.iter().enumerate().filter(|&(_, &m)| m) {
+        a += f64::from(ours.pixels[p].element_sum());
+        b += f64::from(reference.pixels[p].element_sum());
+        n += 1;
     }
     (a / b - 1.0, n)
 }
@@ -365,14 +370,15 @@ fn the_strip_a_ball_overhangs_gets_its_own_inter_reflected_light() {
             .zip(&blocked)
             .map(|(p, &b)| p.is_some_and(on_top) && !b)
             .collect();
-        let strip = |p: Vec3| {
-            let i = points.iter().position(|q| *q == Some(p)).unwrap();
-            lit[i]
-        };
+        let shaded: Vec<bool> = points
+            .iter()
+            .zip(&lit)
+            .map(|(p, &lit)| p.is_some_and(on_top) && !lit)
+            .collect();
         let reference = traced(&scene, vis.as_ref(), 2048);
         let ours = meshless(&scene, vis.as_ref(), RenderOptions::default().gather_rays);
-        let (e, n) = band(&ours, &reference, &points, strip);
-        let (shade, m) = band(&ours, &reference, &points, |p| on_top(p) && !strip(p));
+        let (e, n) = pixels(&ours, &reference, &lit);
+        let (shade, m) = pixels(&ours, &reference, &shaded);
         eprintln!(
             "{backend}: the lit strip {:+.2}% ({n} pixels), the top in the ball's shadow {:+.2}% ({m} pixels)",
             100.0 * e,

@@ -361,7 +361,7 @@ fn gather_new(
     let row_scale: &[f32] = state.row_scale;
     let mut gathered = vec![(glam::DVec3::ZERO, 0u64); samples.len() - regather.first];
     crate::parallel::for_chunks(&mut gathered, 64, threads, |first, chunk| {
-        let (mut segments, mut found) = (Vec::new(), Vec::new());
+        let (mut segments, mut found, mut blocked) = (Vec::new(), Vec::new(), Vec::new());
         for (out, k) in chunk.iter_mut().zip(regather.first + first..) {
             segments.clear();
             found.clear();
@@ -375,7 +375,8 @@ fn gather_new(
                     found.push((j, f));
                 }
             }
-            let mut blocked = vec![false; segments.len()];
+            blocked.clear();
+            blocked.resize(segments.len(), false);
             vis.occluded(&segments, &mut blocked)?;
             let mut h = glam::DVec3::ZERO;
             for (&(j, f), &blocked) in found.iter().zip(&blocked) {

@@ -645,24 +645,23 @@ fn regather_once(
     let shot = warm::shot(state.irradiance, state.unshot, state.reflectance);
     set(&shot, state.row_scale);
     let bytes = sweeps.run(groups)?;
-    let mut gathered = vec![DVec3::ZERO; state.samples.len()];
     for group in groups.iter() {
         let first = first_member(tree, group.root);
         for (p, &h) in group.delivered.iter().enumerate() {
-            gathered[tree.order[first + p] as usize] = h;
+            let k = tree.order[first + p] as usize;
+            if k >= regather.first {
+                let through = state
+                    .specular
+                    .map_or(DVec3::ZERO, |g| g.row_times(k, &shot));
+                regather.apply(
+                    state.irradiance,
+                    state.unshot,
+                    state.reflectance,
+                    k,
+                    h + through,
+                );
+            }
         }
-    }
-    for (k, &h) in gathered.iter().enumerate().skip(regather.first) {
-        let through = state
-            .specular
-            .map_or(DVec3::ZERO, |g| g.row_times(k, &shot));
-        regather.apply(
-            state.irradiance,
-            state.unshot,
-            state.reflectance,
-            k,
-            h + through,
-        );
     }
     Ok(bytes)
 }
