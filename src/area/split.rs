@@ -508,9 +508,7 @@ impl Splitter<'_> {
         }
         // Ascending sample order: the sum does not depend on the grid's iteration order.
         near.sort_unstable_by_key(|&(k, _)| k);
-        let weight = |d2: f32| f64::from((-self.alpha * d2.sqrt() / r).exp());
-        let total: f64 = near.iter().map(|&(_, d2)| weight(d2)).sum();
-        split_units(near.iter().map(|&(_, d2)| weight(d2) / total), units, rest);
+        split_units(weights(self.alpha, r, near), units, rest);
         Ok(false)
     }
 
@@ -558,6 +556,25 @@ impl Splitter<'_> {
         }
         Ok(())
     }
+}
+
+/// The area weights w(d) = exp(−α d / R) of a cell's samples at squared distances `near`
+/// (eq. 5), normalised to add up to 1.
+fn weights(alpha: f32, r: f32, near: &[(u32, f32)]) -> impl Iterator<Item = f64> + '_ {
+    let weight = move |d2: f32, from: f32| f64::from((-alpha * (d2.sqrt() - from) / r).exp());
+    let mut from = 0.0;
+    let mut total: f64 = near.iter().map(|&(_, d2)| weight(d2, from)).sum();
+    if !total.is_normal() {
+        // A steep fall-off underflows every weight: measured from the nearest sample's
+        // distance they give the same shares (the factor cancels), and the nearest weighs 1.
+        from = near
+            .iter()
+            .map(|n| n.1)
+            .fold(f32::INFINITY, f32::min)
+            .sqrt();
+        total = near.iter().map(|&(_, d2)| weight(d2, from)).sum();
+    }
+    near.iter().map(move |&(_, d2)| weight(d2, from) / total)
 }
 
 /// Each sample's shares from a run, from its (sample, cell) pairs.
@@ -633,6 +650,23 @@ pub(super) fn counts(runs: &[Run]) -> impl Iterator<Item = (u32, u32)> + '_ {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_steep_fall_off_gives_the_cell_to_its_nearest_sample() {
+        let near = [(0, 0.25), (1, 0.04), (2, 0.09)];
+        // By hand at α = 2, R = 1: exp(−2 d) for d = 0.5, 0.2, 0.3, normalised.
+        let w: Vec<f64> = [0.5f64, 0.2, 0.3]
+            .iter()
+            .map(|d| (-2.0 * d).exp())
+            .collect();
+        let sum: f64 = w.iter().sum();
+        for (got, want) in weights(2.0, 1.0, &near).zip(&w) {
+            assert!((got - want / sum).abs() < 1e-6, "{got} vs {}", want / sum);
+        }
+        // α = 10³⁰ underflows every weight: the nearest takes the whole cell.
+        let got: Vec<f64> = weights(1e30, 1.0, &near).collect();
+        assert_eq!(got, [0.0, 1.0, 0.0]);
+    }
 
     #[test]
     fn runs_read_back_as_written() {
