@@ -10,7 +10,7 @@ mod common;
 use common::{backends, camera, material, Builder};
 use glam::Vec3;
 use meshlight::visibility::Ray;
-use meshlight::{Control, Direct, Options, Quantity, RenderOptions, Scene};
+use meshlight::{Backend, Control, Direct, Options, Quantity, RenderOptions, Scene};
 
 /// The light: [LIGHT.0, LIGHT.1]² in x and z, at this height, facing down.
 const LIGHT: (f32, f32) = (1.5, 2.5);
@@ -88,49 +88,56 @@ fn full_factor(p: Vec3) -> f64 {
         + corner(a - x, a - z, h)
 }
 
+/// The shelf room rendered (irradiance, each pixel its centre ray, 16 shadow rays per hit):
+/// each pixel that sees the floor with the floor point it sees and its value, and the
+/// irradiance per unit form factor read from the fully lit floor (one exact answer: every
+/// shadow ray arrives, so the estimator returns Lambert's formula).
+fn floor_seen(scene: &Scene, backend: Backend) -> (Vec<(Vec3, f64)>, f64) {
+    let vis = backend.build(scene).unwrap();
+    let solution = meshlight::solve(scene, vis.as_ref(), &Options::default(), &mut |_| {
+        Control::Continue
+    })
+    .unwrap();
+    let options = RenderOptions {
+        quantity: Quantity::Irradiance,
+        direct: Direct::Traced { light_samples: 16 },
+        // Each pixel its centre ray: the floor point it sees is the one compared.
+        supersample: 1,
+        ..Default::default()
+    };
+    let (image, _) = meshlight::render(scene, &solution, vis.as_ref(), &options, &mut |_| {
+        Control::Continue
+    })
+    .unwrap();
+    let rays: Vec<Ray> = scene.camera().pixel_centres().collect();
+    let mut hits = vec![None; rays.len()];
+    vis.intersect(&rays, &mut hits).unwrap();
+    let floor: Vec<(Vec3, f64)> = (0..rays.len())
+        .filter_map(|p| {
+            let point = rays[p].origin + hits[p].as_ref()?.t * rays[p].dir;
+            (point.y < 1e-3).then_some((point, f64::from(image.pixels[p].x)))
+        })
+        .collect();
+    let scale = floor
+        .iter()
+        .filter(|&&(q, _)| (visible_factor(q) - full_factor(q)).abs() < 1e-12)
+        .map(|&(q, value)| value / full_factor(q))
+        .fold(f64::NAN, f64::max);
+    assert!(scale > 0.0, "{backend}: no fully lit floor in view");
+    (floor, scale)
+}
+
 #[test]
 fn the_penumbra_follows_the_closed_form_pixel_by_pixel() {
     let scene = shelf_room(64);
     for backend in backends() {
-        let vis = backend.build(&scene).unwrap();
-        let solution = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |_| {
-            Control::Continue
-        })
-        .unwrap();
-        let options = RenderOptions {
-            quantity: Quantity::Irradiance,
-            direct: Direct::Traced { light_samples: 16 },
-            // Each pixel its centre ray: the floor point it sees is the one compared.
-            supersample: 1,
-            ..Default::default()
-        };
-        let (image, _) = meshlight::render(&scene, &solution, vis.as_ref(), &options, &mut |_| {
-            Control::Continue
-        })
-        .unwrap();
-        let rays: Vec<Ray> = scene.camera().pixel_centres().collect();
-        let mut hits = vec![None; rays.len()];
-        vis.intersect(&rays, &mut hits).unwrap();
-        let floor: Vec<(usize, Vec3)> = (0..rays.len())
-            .filter_map(|p| {
-                let point = rays[p].origin + hits[p].as_ref()?.t * rays[p].dir;
-                (point.y < 1e-3).then_some((p, point))
-            })
-            .collect();
-        // The irradiance per unit form factor, from the fully lit floor (one exact answer:
-        // every shadow ray arrives, so the estimator returns Lambert's formula).
-        let scale = floor
-            .iter()
-            .filter(|&&(_, q)| (visible_factor(q) - full_factor(q)).abs() < 1e-12)
-            .map(|&(p, q)| f64::from(image.pixels[p].x) / full_factor(q))
-            .fold(f64::NAN, f64::max);
-        assert!(scale > 0.0, "{backend}: no fully lit floor in view");
+        let (floor, scale) = floor_seen(&scene, backend);
         let (mut squares, mut count, mut signed) = (0.0f64, 0usize, 0.0f64);
-        for &(p, q) in &floor {
+        for &(q, value) in &floor {
             let share = visible_factor(q) / full_factor(q);
             if (0.05..0.95).contains(&share) {
                 let exact = scale * visible_factor(q);
-                let e = (f64::from(image.pixels[p].x) - exact) / exact;
+                let e = (value - exact) / exact;
                 squares += e * e;
                 signed += e;
                 count += 1;
@@ -157,42 +164,14 @@ fn the_penumbra_follows_the_closed_form_pixel_by_pixel() {
 fn the_penumbras_rims_are_not_too_bright_or_too_dark() {
     let scene = shelf_room(160);
     for backend in backends() {
-        let vis = backend.build(&scene).unwrap();
-        let solution = meshlight::solve(&scene, vis.as_ref(), &Options::default(), &mut |_| {
-            Control::Continue
-        })
-        .unwrap();
-        let options = RenderOptions {
-            quantity: Quantity::Irradiance,
-            direct: Direct::Traced { light_samples: 16 },
-            supersample: 1,
-            ..Default::default()
-        };
-        let (image, _) = meshlight::render(&scene, &solution, vis.as_ref(), &options, &mut |_| {
-            Control::Continue
-        })
-        .unwrap();
-        let rays: Vec<Ray> = scene.camera().pixel_centres().collect();
-        let mut hits = vec![None; rays.len()];
-        vis.intersect(&rays, &mut hits).unwrap();
-        let floor: Vec<(usize, Vec3)> = (0..rays.len())
-            .filter_map(|p| {
-                let point = rays[p].origin + hits[p].as_ref()?.t * rays[p].dir;
-                (point.y < 1e-3).then_some((p, point))
-            })
-            .collect();
-        let scale = floor
-            .iter()
-            .filter(|&&(_, q)| (visible_factor(q) - full_factor(q)).abs() < 1e-12)
-            .map(|&(p, q)| f64::from(image.pixels[p].x) / full_factor(q))
-            .fold(f64::NAN, f64::max);
+        let (floor, scale) = floor_seen(&scene, backend);
         for (lo, hi) in [(0.9, 0.999), (0.001, 0.1)] {
             let (mut signed, mut count) = (0.0f64, 0usize);
-            for &(p, q) in &floor {
+            for &(q, value) in &floor {
                 let share = visible_factor(q) / full_factor(q);
                 if (lo..hi).contains(&share) {
                     let full = scale * full_factor(q);
-                    signed += (f64::from(image.pixels[p].x) - scale * visible_factor(q)) / full;
+                    signed += (value - scale * visible_factor(q)) / full;
                     count += 1;
                 }
             }
