@@ -158,15 +158,18 @@ impl Builder {
         }
     }
 
-    /// A faceted ball, as the gallery's sculptures are: an icosahedron whose faces are cut in
-    /// four `detail` times, facing out.
+    /// A faceted ball, as the gallery's sculptures are (their icosphere): an icosahedron whose
+    /// faces are cut in four `detail` times, facing out.
     pub fn ball(&mut self, centre: Vec3, radius: f32, detail: u32, material: u32) {
-        for corners in icosphere(detail) {
-            let base = self.mesh.positions.len() as u32;
-            self.mesh
-                .positions
-                .extend(corners.map(|p| centre + radius * p));
-            self.mesh.triangles.push([base, base + 1, base + 2]);
+        let (vertices, faces) = meshlight_gallery::unit_icosphere(detail);
+        let base = self.mesh.positions.len() as u32;
+        self.mesh.positions.extend(
+            vertices
+                .iter()
+                .map(|&p| centre + radius * Vec3::from(p.map(|x| x as f32))),
+        );
+        for f in faces {
+            self.mesh.triangles.push(f.map(|i| base + i as u32));
             self.mesh.triangle_materials.push(material);
         }
     }
@@ -299,62 +302,4 @@ pub fn assert_dark_room_is_dark(s: &meshlight::Solution, label: &str) {
         dark > 100 && lit > 100,
         "{label}: {dark} dark, {lit} lit samples"
     );
-}
-
-/// The unit icosphere's triangles, each face cut in four `detail` times, counter-clockwise
-/// seen from outside.
-fn icosphere(detail: u32) -> Vec<[Vec3; 3]> {
-    let t = (1.0 + 5f32.sqrt()) / 2.0;
-    let v = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .map(|(x, y, z)| Vec3::new(x, y, z).normalize());
-    let faces = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let mut out: Vec<[Vec3; 3]> = faces.iter().map(|f| f.map(|i| v[i])).collect();
-    for _ in 0..detail {
-        out = out
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let (ab, bc, ca) = (
-                    (a + b).normalize(),
-                    (b + c).normalize(),
-                    (c + a).normalize(),
-                );
-                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
-            })
-            .collect();
-    }
-    out
 }

@@ -127,7 +127,8 @@ pub struct Stats {
     pub triangles: usize,
 }
 
-type P = [f64; 3];
+/// A point or vector, in metres.
+pub type P = [f64; 3];
 
 /// An OBJ under construction: deduplicated vertices, faces grouped by material.
 #[derive(Default)]
@@ -298,6 +299,20 @@ fn block(obj: &mut Obj, material: &str, min: P, max: P, bottom: bool) {
 
 /// A faceted icosphere (flat facets: each is one planar surface for the solver).
 fn icosphere(obj: &mut Obj, material: &str, centre: P, radius: f64, detail: u32) {
+    let (v, faces) = unit_icosphere(detail);
+    for f in faces {
+        let corners: Vec<P> = f
+            .iter()
+            .map(|&i| add(centre, scale(v[i], radius)))
+            .collect();
+        let c = scale(add(add(v[f[0]], v[f[1]]), v[f[2]]), 1.0 / 3.0);
+        obj.polygon(material, corners, c);
+    }
+}
+
+/// The unit icosphere of the sculptures: an icosahedron whose faces are cut in four `detail`
+/// times; its vertices and its triangles (indices, counter-clockwise seen from outside).
+pub fn unit_icosphere(detail: u32) -> (Vec<P>, Vec<[usize; 3]>) {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
     let mut v: Vec<P> = [
         [-1.0, t, 0.0],
@@ -353,14 +368,7 @@ fn icosphere(obj: &mut Obj, material: &str, centre: P, radius: f64, detail: u32)
         }
         faces = next;
     }
-    for f in faces {
-        let corners: Vec<P> = f
-            .iter()
-            .map(|&i| add(centre, scale(v[i], radius)))
-            .collect();
-        let c = scale(add(add(v[f[0]], v[f[1]]), v[f[2]]), 1.0 / 3.0);
-        obj.polygon(material, corners, c);
-    }
+    (v, faces)
 }
 
 /// A framed painting on a wall: canvas 2 cm off the wall, a frame of four bars around it.
