@@ -398,10 +398,10 @@ fn the_office_year_matches_one_moment_solves_hour_by_hour() {
         })
         .unwrap_or_else(|e| panic!("{e}"));
         let n = year.grids[0].points.len();
-        // 20 hours spread over the year: every 220th hour with the sun up.
+        // Ten hours spread over the year: every 440th hour with the sun up.
         let (mut clear, mut overcast, mut sun_in) = (0, 0, 0);
         let mut worst: (f64, f64) = (0.0, 0.0);
-        for k in (0..20).map(|i| 100 + 220 * i) {
+        for k in (0..10).map(|i| 100 + 440 * i) {
             let stamp = year.sun_hours[k];
             let h = weather
                 .hours
@@ -449,18 +449,23 @@ fn the_office_year_matches_one_moment_solves_hour_by_hour() {
             );
             worst = (worst.0.max(off_mean), worst.1.max(off_point));
             let dn = h.direct_normal_lx.unwrap();
-            clear += usize::from(dn > 20_000.0);
+            let is_clear = dn > 20_000.0;
+            clear += usize::from(is_clear);
             overcast += usize::from(dn < 1_000.0);
-            // The sun on the work plane: some point far above the sky's light alone.
-            sun_in += usize::from(one.iter().any(|&v| v > 3.0 * mean(&one)));
+            // The sun's patch on the work plane: a clear hour with some point lit above 15% of
+            // the direct normal illuminance (a sun above 11° through a pane passing 80%
+            // gives more; the sky through the window gives the brightest point 4-10% of it).
+            let brightest = one.iter().copied().fold(0.0, f64::max);
+            sun_in += usize::from(is_clear && brightest > 0.15 * dn);
         }
-        // The hours span clear and overcast skies, the sun in and out of the window.
+        // The hours span clear and overcast skies, and clear hours with the sun on the work
+        // plane (a low winter sun through the south window) and without (a high summer one).
         assert!(
-            clear >= 3 && overcast >= 3 && (2..20).contains(&sun_in),
-            "{clear} {overcast} {sun_in}"
+            clear >= 3 && overcast >= 2 && sun_in >= 1 && sun_in < clear,
+            "clear {clear}, overcast {overcast}, the sun on the plane {sun_in}"
         );
         eprintln!(
-            "{}: worst mean {:.2}%, worst point {:.2}% over 20 hours",
+            "{}: worst mean {:.2}%, worst point {:.2}% over 10 hours",
             backend.name(),
             100.0 * worst.0,
             100.0 * worst.1

@@ -96,12 +96,16 @@ fn meshless(scene: &Scene, vis: &dyn Visibility, gather_rays: u32) -> Image {
         .0
 }
 
-fn traced(scene: &Scene, vis: &dyn Visibility, spp: u32) -> Image {
+/// The path tracer's image at `spp`, traced once on the first backend: the second method, the
+/// same for every backend the meshless image is checked on (the backends' own agreement is
+/// `tests/backends.rs`'s).
+fn traced(scene: &Scene, spp: u32) -> Image {
     let options = PathOptions {
         spp,
         ..PathOptions::default()
     };
-    path_trace(scene, vis, &options, &mut |_| Control::Continue)
+    let vis = backends()[0].build(scene).unwrap();
+    path_trace(scene, vis.as_ref(), &options, &mut |_| Control::Continue)
         .unwrap()
         .image
 }
@@ -118,10 +122,10 @@ struct Band<'a> {
 /// Renders the scene with and without the gather on every backend and checks each band
 /// against the path tracer at `spp`.
 fn check(scene: &Scene, spp: u32, bands: &[Band]) {
+    let reference = traced(scene, spp);
     for backend in backends() {
         let vis = backend.build(scene).unwrap();
         let points = seen(scene, vis.as_ref());
-        let reference = traced(scene, vis.as_ref(), spp);
         let ours = meshless(scene, vis.as_ref(), RenderOptions::default().gather_rays);
         let plain = meshless(scene, vis.as_ref(), 0);
         for b in bands {
@@ -233,9 +237,9 @@ fn corner_under_a_lamp() -> Scene {
 /// dots; the path tracer's are its own noise and the scene's few features a pixel wide).
 fn sparkles_and_blocks(scene: &Scene, check: impl Fn(Backend, ImageError, usize, usize)) {
     let ratio = meshlight::metrics::SPARKLE_RATIO;
+    let reference = traced(scene, 4096);
     for backend in backends() {
         let vis = backend.build(scene).unwrap();
-        let reference = traced(scene, vis.as_ref(), 4096);
         let ours = meshless(scene, vis.as_ref(), RenderOptions::default().gather_rays);
         let e = meshlight::metrics::compare_blocks(&ours, &reference, 4).unwrap();
         let (n, n_ref) = (
@@ -345,6 +349,7 @@ fn the_strip_a_ball_overhangs_gets_its_own_inter_reflected_light() {
     // which see neither the lamp's pool nor most of the room: the strip read 20% dark in the
     // gallery. Each new sample now gathers its own along the links.
     let scene = ball_on_a_pedestal();
+    let reference = traced(&scene, 2048);
     for backend in backends() {
         let vis = backend.build(&scene).unwrap();
         let points = seen(&scene, vis.as_ref());
@@ -375,7 +380,6 @@ fn the_strip_a_ball_overhangs_gets_its_own_inter_reflected_light() {
             .zip(&lit)
             .map(|(p, &lit)| p.is_some_and(on_top) && !lit)
             .collect();
-        let reference = traced(&scene, vis.as_ref(), 2048);
         let ours = meshless(&scene, vis.as_ref(), RenderOptions::default().gather_rays);
         let (e, n) = pixels(&ours, &reference, &lit);
         let (shade, m) = pixels(&ours, &reference, &shaded);

@@ -9,7 +9,7 @@ mod common;
 use std::sync::{Arc, Barrier, Mutex};
 
 use meshlight::distributed::Ranks;
-use meshlight::{Control, Image, Options, RenderOptions, Scene, Solution};
+use meshlight::{Backend, Control, Image, Options, RenderOptions, Scene, Solution};
 
 /// What the simulated ranks share: a slot per rank, and a barrier.
 struct Shared {
@@ -116,8 +116,8 @@ fn same(a: &Solution, b: &Solution, what: &str) {
     }
 }
 
-fn check_scene(scene: &Scene, options: &Options) {
-    for backend in common::backends() {
+fn check_scene(scene: &Scene, options: &Options, backends: &[Backend]) {
+    for &backend in backends {
         let vis = backend.build(scene).unwrap();
         let one =
             meshlight::solve(scene, vis.as_ref(), options, &mut |_| Control::Continue).unwrap();
@@ -182,7 +182,7 @@ fn the_room_on_two_and_three_ranks_is_one_process_solve() {
         threads: 1,
         ..Options::default()
     };
-    check_scene(&scene, &options);
+    check_scene(&scene, &options, &common::backends());
 }
 
 #[test]
@@ -195,5 +195,7 @@ fn a_reduced_gallery_on_two_and_three_ranks_is_one_process_solve() {
         rounds: 1,
         ..Options::default()
     };
-    check_scene(&scene, &options);
+    // One backend: what the ranks share does not depend on the ray caster, which the room
+    // above checks on every backend; the gallery adds its size (many groups, long messages).
+    check_scene(&scene, &options, &[Backend::default_backend()]);
 }
