@@ -33,18 +33,13 @@ ref room 4096; ref cornell 8192; ref gallery 8192
 "$M" sweep cornell/scene.toml --reference ref_cornell.exr --vary preset=preview,default,final --no-pathtrace --block 4 --out presets_cornell > presets_cornell.txt 2>/dev/null
 "$M" sweep gallery/scene.toml --reference ref_gallery.exr --vary preset=preview,default,final --no-pathtrace --block 4 --out presets_gallery > presets_gallery.txt 2>/dev/null
 
-# One thread against two on the room (256²) and the gallery (768×512): three alternating pairs,
-# the render's own time from each summary; the images must be the same bit for bit.
-: > threads.txt
-for s in room/scene.toml "$ROOT/scenes/gallery/scene.toml"; do
-  for i in 1 2 3; do
-    for t in 1 2; do
-      "$M" render "$s" --threads $t -o "threads_$t.exr" > "threads_$t.log" 2>/dev/null
-      echo "$s threads $t: $(grep -E '^render|^total' "threads_$t.log" | tr '\n' ' ')" >> threads.txt
-    done
-    cmp threads_1.exr threads_2.exr && echo "$s: 1 and 2 threads bit-identical" >> threads.txt
-  done
-done
+# One thread against two: the render of the room (256², at the defaults and at the cheapest
+# preview) and of the gallery (768×512), each timed at 1 and 2 threads in turn, against the
+# same rays cast on their own; the images must be the same bit for bit.
+"$M" bench-render room/scene.toml --width 256 --height 256 --quiet > threads_room.txt 2>/dev/null
+"$M" bench-render room/scene.toml --width 256 --height 256 --preset preview --epsilon-scale 3 \
+  --repeats 9 --quiet > threads_room_preview.txt 2>/dev/null
+"$M" bench-render "$ROOT/scenes/gallery/scene.toml" --repeats 3 --quiet > threads_gallery.txt 2>/dev/null
 
 # The cluster threshold against the flat solve of the same settings.
 : > threshold.txt

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use clap::builder::TypedValueParser as _;
 use clap::{Parser, Subcommand};
 use meshlight::visibility::BvhPreset;
 use meshlight::{Backend, Options};
@@ -340,6 +341,31 @@ pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String>
     Ok((key, values))
 }
 
+/// `bench-render`'s arguments: the solve's and the render's as `render` takes them.
+#[derive(clap::Args)]
+pub struct BenchRenderArgs {
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Image width in pixels, instead of the scene's; with only one of --width and --height,
+    /// the other keeps the camera's aspect ratio.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub width: Option<u32>,
+    /// Image height in pixels, instead of the scene's.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub height: Option<u32>,
+    #[command(flatten)]
+    pub render: RenderFlags,
+    /// Thread counts to render with, comma-separated (the solve uses --threads).
+    #[arg(long, value_delimiter = ',', default_values_t = [1, 2],
+          value_parser = clap::value_parser!(u16).range(1..=1024).map(usize::from))]
+    pub render_threads: Vec<usize>,
+    /// Renders at each thread count (alternating between the counts); the figures are their
+    /// median.
+    #[arg(long, default_value_t = 5,
+          value_parser = clap::value_parser!(u16).range(1..=1000).map(usize::from))]
+    pub repeats: usize,
+}
+
 /// `bench-vis`'s arguments.
 #[derive(clap::Args)]
 pub struct BenchArgs {
@@ -483,6 +509,9 @@ pub enum Command {
     },
     /// Measure the visibility backends on a scene (occlusion and closest-hit rates).
     BenchVis(BenchArgs),
+    /// Measure the render: one solve, the image rendered at each thread count in turn, its
+    /// time per pixel against the same rays cast on their own.
+    BenchRender(BenchRenderArgs),
 }
 
 /// Parses `--bvh-preset` names.

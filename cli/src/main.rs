@@ -3,6 +3,7 @@
 mod annual;
 mod args;
 mod bench;
+mod bench_render;
 mod errors;
 mod lux;
 mod memory;
@@ -218,6 +219,7 @@ fn run(command: Command, loading: &LoadOptions) -> anyhow::Result<()> {
             Ok(())
         }
         Command::BenchVis(bench) => bench_vis(bench, loading),
+        Command::BenchRender(bench) => bench_render(bench, loading),
     }
 }
 
@@ -523,6 +525,37 @@ fn bench_vis(b: BenchArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         eprintln!("  {step}...");
     })?;
     print!("{}", bench_report(&scene, &report));
+    Ok(())
+}
+
+/// `bench-render`: one solve, then the render timed at each thread count.
+fn bench_render(b: BenchRenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
+    let (mut scene, options) = solve_setup(&b.solve, loading)?;
+    if b.width.is_some() || b.height.is_some() {
+        let camera = resized(*scene.camera(), b.width, b.height);
+        scene.set_camera(camera)?;
+    }
+    let vis = backend_from(&b.solve.knobs).build(&scene)?;
+    diagnose(&scene, vis.as_ref())?;
+    let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
+    let preset = render_options_from(&b.solve.knobs, &b.render)?;
+    let render = meshlight::RenderOptions {
+        memory_budget: options.memory_budget,
+        ..preset
+    };
+    let report = bench_render::run(
+        &scene,
+        &solution,
+        vis.as_ref(),
+        &render,
+        (&b.render_threads, b.repeats),
+        &mut |step| {
+            if !progress::quiet() {
+                eprintln!("  {step}...");
+            }
+        },
+    )?;
+    print!("{}", bench_render::report(&scene, vis.name(), &report));
     Ok(())
 }
 

@@ -21,6 +21,11 @@ pub fn set_quiet(quiet: bool) {
     QUIET.store(quiet, Ordering::Relaxed);
 }
 
+/// Whether `--quiet` silenced the progress lines.
+pub fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
 /// Runs `call` with a progress line on stderr about `what` ("solve" gives rounds and samples),
 /// cleared when it returns. Where stderr is not a terminal (a log file, a batch job) a bar
 /// would show nothing: a plain line is written instead at the first report and then every

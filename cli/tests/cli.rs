@@ -1256,3 +1256,85 @@ fn render_takes_the_image_size_from_the_command_line_keeping_the_aspect_ratio() 
         text(&run.stderr)
     );
 }
+
+/// The number just before `key` in `line`.
+fn number_before(line: &str, key: &str) -> u64 {
+    let head = &line[..line
+        .find(key)
+        .unwrap_or_else(|| panic!("no '{key}' in {line}"))];
+    let word = head.trim_end().rsplit([' ', '(']).next().unwrap();
+    word.parse()
+        .unwrap_or_else(|_| panic!("no count before '{key}' in {line}"))
+}
+
+#[test]
+fn bench_render_times_each_thread_count_and_counts_the_rays_render_casts() {
+    let size = ["--width", "64", "--height", "48"];
+    let mut args = vec![
+        "bench-render",
+        "scenes/room/scene.toml",
+        "--repeats",
+        "2",
+        "--render-threads",
+        "1,2",
+        "--quiet",
+    ];
+    args.extend(size);
+    let bench = text(&succeed(&args).stdout);
+    // The same image through `render`: its summary counts the same rays.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("room.exr");
+    let mut args = vec![
+        "render",
+        "scenes/room/scene.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend(size);
+    let render = text(&succeed(&args).stdout);
+    let rendered = render
+        .lines()
+        .find(|l| l.starts_with("render 64x48:"))
+        .unwrap_or_else(|| panic!("{render}"));
+    let each = bench
+        .lines()
+        .find(|l| l.starts_with("each render:"))
+        .unwrap_or_else(|| panic!("{bench}"));
+    for key in [
+        "camera rays",
+        "edge pixels supersampled",
+        "shadow rays",
+        "interpolation queries",
+    ] {
+        assert_eq!(
+            number_before(each, key),
+            number_before(rendered, key),
+            "{key}:\n{bench}\n{rendered}"
+        );
+    }
+    assert!(bench.contains("64 x 48 (3072 pixels)"), "{bench}");
+    // A row per thread count: its median is of its two renders, its time per pixel the
+    // median over the pixels.
+    for threads in ["1", "2"] {
+        let row = bench
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(threads))
+            .unwrap_or_else(|| panic!("no row for {threads} thread(s):\n{bench}"));
+        let cells: Vec<f64> = row.split_whitespace().map(|c| c.parse().unwrap()).collect();
+        // Threads, median s, best s, ns a pixel, rays alone s, render / rays, then the 2
+        // renders.
+        assert_eq!(cells.len(), 8, "{row}");
+        let (median, best, ns) = (cells[1], cells[2], cells[3]);
+        assert!((median - 0.5 * (cells[6] + cells[7])).abs() < 1e-3, "{row}");
+        assert!((best - cells[6].min(cells[7])).abs() < 1e-3, "{row}");
+        // The median is printed to 0.1 ms: 16 ns a pixel here.
+        assert!((ns - median * 1e9 / 3072.0).abs() <= 17.0, "{row}");
+        assert!(cells[4] > 0.0 && cells[5] > 0.0, "{row}");
+    }
+    assert!(bench.contains("1 -> 2 threads: the render"), "{bench}");
+    assert!(
+        bench.contains("every render's image the same bit for bit: yes"),
+        "{bench}"
+    );
+}
