@@ -228,6 +228,18 @@ pub const RENDER_KEYS: [&str; 8] = [
     "patch-size",
 ];
 
+/// The image's size in pixels, instead of the scene camera's.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct ImageSize {
+    /// Image width in pixels, instead of the scene's (a .glb carries none); with only one of
+    /// --width and --height, the other keeps the camera's aspect ratio.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub width: Option<u32>,
+    /// Image height in pixels, instead of the scene's.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub height: Option<u32>,
+}
+
 /// `render`'s arguments.
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -236,13 +248,8 @@ pub struct RenderArgs {
     /// Output image (.exr); the PNG gets the same name with .png.
     #[arg(short, long, default_value = "out.exr")]
     pub output: PathBuf,
-    /// Image width in pixels, instead of the scene's (a .glb carries none); with only one of
-    /// --width and --height, the other keeps the camera's aspect ratio.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub width: Option<u32>,
-    /// Image height in pixels, instead of the scene's.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSize,
     #[command(flatten)]
     pub render: RenderFlags,
     /// How to compute the image: meshless (the solver), or pathtrace (the independent
@@ -346,13 +353,8 @@ pub fn parse_vary(s: &str) -> std::result::Result<(String, Vec<String>), String>
 pub struct BenchRenderArgs {
     #[command(flatten)]
     pub solve: SolveArgs,
-    /// Image width in pixels, instead of the scene's; with only one of --width and --height,
-    /// the other keeps the camera's aspect ratio.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub width: Option<u32>,
-    /// Image height in pixels, instead of the scene's.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSize,
     #[command(flatten)]
     pub render: RenderFlags,
     /// Thread counts to render with, comma-separated (the solve uses --threads).

@@ -306,10 +306,7 @@ fn render_command(r: RenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
         anyhow::bail!("--false-color works with --method meshless only");
     }
     let (mut scene, options) = solve_setup(&r.solve, loading)?;
-    if r.width.is_some() || r.height.is_some() {
-        let camera = resized(*scene.camera(), r.width, r.height);
-        scene.set_camera(camera)?;
-    }
+    resize(&mut scene, r.size)?;
     if r.method != Method::Meshless && ranks::ranks().size() > 1 {
         anyhow::bail!("--method {:?} runs on one rank only", r.method);
     }
@@ -531,10 +528,7 @@ fn bench_vis(b: BenchArgs, loading: &LoadOptions) -> anyhow::Result<()> {
 /// `bench-render`: one solve, then the render timed at each thread count.
 fn bench_render(b: BenchRenderArgs, loading: &LoadOptions) -> anyhow::Result<()> {
     let (mut scene, options) = solve_setup(&b.solve, loading)?;
-    if b.width.is_some() || b.height.is_some() {
-        let camera = resized(*scene.camera(), b.width, b.height);
-        scene.set_camera(camera)?;
-    }
+    resize(&mut scene, b.size)?;
     let vis = backend_from(&b.solve.knobs).build(&scene)?;
     diagnose(&scene, vis.as_ref())?;
     let solution = solve_with_progress(&scene, vis.as_ref(), &options)?;
@@ -567,6 +561,15 @@ fn diagnose(scene: &Scene, vis: &dyn meshlight::Visibility) -> anyhow::Result<()
             anyhow::bail!("{}: {}", scene.path().display(), finding.message);
         }
         eprintln!("meshlight: warning: {}", finding.message);
+    }
+    Ok(())
+}
+
+/// The scene's camera resized where the command line gives a size.
+fn resize(scene: &mut Scene, size: ImageSize) -> anyhow::Result<()> {
+    if size.width.is_some() || size.height.is_some() {
+        let camera = resized(*scene.camera(), size.width, size.height);
+        scene.set_camera(camera)?;
     }
     Ok(())
 }
