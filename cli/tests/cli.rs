@@ -1269,7 +1269,17 @@ fn number_before(line: &str, key: &str) -> u64 {
 
 #[test]
 fn bench_render_times_each_thread_count_and_counts_the_rays_render_casts() {
-    let size = ["--width", "64", "--height", "48"];
+    // Not the defaults' render flags: a bench that ignored them would count other rays.
+    let size = [
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--supersample",
+        "2",
+        "--direct-rays",
+        "8",
+    ];
     let mut args = vec![
         "bench-render",
         "scenes/room/scene.toml",
