@@ -454,7 +454,8 @@ fn the_office_year_matches_one_moment_solves_hour_by_hour() {
             overcast += usize::from(dn < 1_000.0);
             // The sun's patch on the work plane: a clear hour with some point lit above 15% of
             // the direct normal illuminance (a sun above 11° through a pane passing 80%
-            // gives more; the sky through the window gives the brightest point 4-10% of it).
+            // gives more; in the clear hours taken without it, the brightest point gets 9.5%
+            // and 12.9% of it from the sky through the window).
             let brightest = one.iter().copied().fold(0.0, f64::max);
             sun_in += usize::from(is_clear && brightest > 0.15 * dn);
         }

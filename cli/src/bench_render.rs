@@ -22,8 +22,9 @@ pub struct ThreadRuns {
     pub threads: usize,
     /// Each render's own time, seconds, in the order run.
     pub seconds: Vec<f64>,
-    /// The rays the render cast (see [`RaysAlone`]), cast on their own at this thread count:
-    /// the best of as many runs as the renders, seconds.
+    /// The rays the render cast, cast on their own at this thread count (camera rays as
+    /// closest-hit queries, the rest as occlusion queries): the best of as many runs as the
+    /// renders, seconds.
     pub rays_alone: f64,
 }
 
