@@ -361,3 +361,92 @@ pub fn image(scene: &Scene, image: &crate::Image) -> Option<Finding> {
         ),
     })
 }
+
+/// A surface narrower than this many ε is sampled along its length only: a row of samples ε
+/// apart, however narrow.
+const NARROW: f64 = 2.0;
+/// The share of the first samples beyond what the area asks for, above which [`samples`] says so.
+const MOSTLY_TESSELLATION: f64 = 0.5;
+/// The fewest first samples on wide surfaces from which their density is read.
+const DENSITY_SAMPLES: usize = 100;
+
+/// The check on a finished solve: whether most of the first (Poisson-disk) samples are there
+/// because surfaces are cut into facets narrower than ε rather than because of their area.
+/// Each planar surface is sampled on its own, at least once and once every ε along its length,
+/// so a column of 48 facets 4 cm wide gets a row of samples on each facet: the samples, and the
+/// links and time with them, follow the mesh's tessellation, and ε moves them only along the
+/// facets' length. The area's share is read from the density on the scene's wide surfaces.
+pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
+    // A solution of another scene has nothing to say about this one (and its sides would not
+    // index this scene's surfaces).
+    solution.check_fits(scene).ok()?;
+    let s = solution.samples();
+    let eps = f64::from(solution.epsilon());
+    if eps.is_nan() || eps <= 0.0 {
+        return None;
+    }
+    let surfaces = scene.surfaces();
+    // Each surface's width: its area over the longest side of its triangles' bounding box.
+    let mut lo = vec![Vec3::splat(f32::INFINITY); surfaces.len()];
+    let mut hi = vec![Vec3::splat(f32::NEG_INFINITY); surfaces.len()];
+    for t in scene.triangles() {
+        let k = t.surface as usize;
+        for v in t.vertices {
+            lo[k] = lo[k].min(v);
+            hi[k] = hi[k].max(v);
+        }
+    }
+    let narrow: Vec<bool> = surfaces
+        .iter()
+        .enumerate()
+        .map(|(k, surface)| {
+            let length = f64::from((hi[k] - lo[k]).max_element());
+            length > 0.0 && surface.area / length < NARROW * eps
+        })
+        .collect();
+    // First samples per side.
+    let mut first = vec![0usize; 2 * surfaces.len()];
+    for (k, &side) in s.side.iter().enumerate() {
+        if let (Some(0), Some(n)) = (s.round.get(k), first.get_mut(side as usize)) {
+            *n += 1;
+        }
+    }
+    let (mut wide_samples, mut wide_area, mut sampled_area) = (0usize, 0.0f64, 0.0f64);
+    let (mut on_narrow, mut narrow_sides, mut total) = (0usize, 0usize, 0usize);
+    for (side, &n) in first.iter().enumerate() {
+        if n == 0 {
+            continue;
+        }
+        let surface = crate::sampling::surface_of(side as u32) as usize;
+        let area = surfaces[surface].area;
+        total += n;
+        sampled_area += area;
+        if narrow[surface] {
+            on_narrow += n;
+            narrow_sides += 1;
+        } else {
+            wide_samples += n;
+            wide_area += area;
+        }
+    }
+    if wide_samples < DENSITY_SAMPLES || wide_area <= 0.0 || total == 0 {
+        return None;
+    }
+    let by_area = wide_samples as f64 / wide_area * sampled_area;
+    let excess = 1.0 - by_area / total as f64;
+    (excess > MOSTLY_TESSELLATION).then(|| Finding {
+        fatal: false,
+        message: format!(
+            "{:.0}% of the {total} first samples are there because surfaces are cut into \
+             facets narrower than {NARROW} ε = {:.3} ({on_narrow} samples on {narrow_sides} such \
+             sides: the facets of columns, arches, mouldings, spheres): each facet is sampled on \
+             its own, once every ε along its length, so the samples, links and time follow the \
+             mesh's tessellation; by their area alone, at the density of the wider surfaces, \
+             about {:.0} would do. Fewer facets on the curved surfaces cost less; ε moves these \
+             samples only along the facets.",
+            100.0 * excess,
+            NARROW * eps,
+            by_area
+        ),
+    })
+}

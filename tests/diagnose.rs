@@ -5,7 +5,7 @@ mod common;
 
 use common::mirror::{facing_down, facing_up, v};
 use common::{backends, camera, material, Builder};
-use meshlight::diagnose::{before_solve, image, Finding};
+use meshlight::diagnose::{before_solve, image, samples, Finding};
 use meshlight::solver::Options;
 use meshlight::Scene;
 
@@ -146,5 +146,101 @@ fn no_shipped_scene_raises_anything() {
     ] {
         let scene = Scene::load(common::shipped(name)).unwrap();
         assert_eq!(findings(&scene), vec![], "{name}");
+    }
+}
+
+/// A 6 × 4 × 6 m room with four columns 0.6 m across from floor to ceiling: round ones of
+/// `facets` facets facing out, or square ones (`facets` 0), and a lamp under the ceiling.
+fn hall_of_columns(facets: u32) -> Scene {
+    let mut b = Builder::default();
+    let grey = b.material(material("grey", 0.6, 0.0));
+    b.room(v(0.0, 0.0, 0.0), v(6.0, 4.0, 6.0), grey, &[]);
+    let (r, h) = (0.3f32, 4.0f32);
+    for (cx, cz) in [(2.0, 2.0), (4.0, 2.0), (2.0, 4.0), (4.0, 4.0)] {
+        if facets == 0 {
+            b.solid(v(cx - r, 0.0, cz - r), v(cx + r, h, cz + r), grey);
+            continue;
+        }
+        let at = |i: u32, y: f32| {
+            let a = std::f32::consts::TAU * i as f32 / facets as f32;
+            v(cx + r * a.cos(), y, cz + r * a.sin())
+        };
+        for i in 0..facets {
+            b.quad([at(i, 0.0), at(i, h), at(i + 1, h), at(i + 1, 0.0)], grey);
+        }
+    }
+    b.point_lights.push(meshlight::scene::PointLight {
+        position: v(3.0, 3.6, 3.0),
+        intensity: glam::Vec3::splat(20.0),
+    });
+    let scene = b.scene(camera(v(0.5, 1.6, 0.5), v(3.0, 1.5, 3.0), 32));
+    // Every column facet faces out, away from its axis.
+    for s in scene.surfaces().iter().filter(|s| s.normal.y.abs() < 0.5) {
+        let t = &scene.triangles()[s.triangles.start as usize];
+        let c = (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0;
+        let axis = v((c.x / 2.0).round() * 2.0, c.y, (c.z / 2.0).round() * 2.0);
+        if (0.2..0.5).contains(&(c - axis).length()) {
+            assert!(s.normal.dot(c - axis) > 0.0, "a facet faces its axis");
+        }
+    }
+    scene
+}
+
+#[test]
+fn columns_of_narrow_facets_are_told_their_samples_follow_the_tessellation() {
+    // Round columns of 96 facets 2 cm wide: each facet gets a row of samples about ε apart
+    // up its 4 m, against some 220 that the columns' 30 m² get at the walls' density.
+    // Square columns of the same size: none of that. The square columns' solve is the second
+    // route to what the area alone asks for: its samples, scaled by the sampled area (168 m²
+    // of room and 30.2 m² of round columns against 38.4 m² of square ones' sides).
+    let backend = backends()[0];
+    let options = Options {
+        epsilon: Some(0.3),
+        rounds: 0,
+        ..Options::default()
+    };
+    let solved = |facets| {
+        let scene = hall_of_columns(facets);
+        let solution = common::solve(&scene, backend, options.clone());
+        let finding = samples(&scene, &solution);
+        (solution.samples().len(), finding)
+    };
+    let (round, told) = solved(96);
+    let (square, silent) = solved(0);
+    eprintln!("samples: round columns {round}, square ones {square}; {told:?}");
+    assert!(silent.is_none(), "square columns: {silent:?}");
+    let told = told.expect("round columns: no finding");
+    assert!(told.message.contains("tessellation") && !told.fatal);
+    assert!(round > 2 * square, "{round} samples against {square}");
+    let by_area: f64 = told
+        .message
+        .split("about ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .expect("the count by area");
+    let expected = square as f64 * (168.0 + 30.2) / (168.0 + 38.4);
+    assert!(
+        (by_area / expected - 1.0).abs() < 0.15,
+        "by area {by_area}, the square columns' solve says {expected:.0}"
+    );
+}
+
+#[test]
+fn no_shipped_scene_is_told_its_samples_follow_the_tessellation() {
+    let gallery = meshlight_gallery::ensure().expect("generate the gallery");
+    for name in ["room", "cornell", "office", "gallery"] {
+        let path = if name == "gallery" {
+            gallery.clone()
+        } else {
+            common::shipped(name)
+        };
+        let scene = Scene::load(path).unwrap();
+        let options = Options {
+            rounds: 0,
+            ..Options::default()
+        };
+        let solution = common::solve(&scene, backends()[0], options);
+        assert_eq!(samples(&scene, &solution), None, "{name}");
     }
 }

@@ -120,9 +120,13 @@ pub fn solve_with_progress(
             100.0 * (1.0 - lit_area / area)
         );
     }
-    Ok(with_progress("solve", |progress| {
+    let solution = with_progress("solve", |progress| {
         meshlight::solver::solve_distributed(scene, vis, options, crate::ranks::ranks(), progress)
-    })?)
+    })?;
+    if let Some(finding) = meshlight::diagnose::samples(scene, &solution) {
+        eprintln!("meshlight: note: {}", finding.message);
+    }
+    Ok(solution)
 }
 
 /// One progress line: what is being done, how far, and the time left.
