@@ -413,6 +413,8 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
     }
     let (mut wide_samples, mut wide_area, mut sampled_area) = (0usize, 0.0f64, 0.0f64);
     let (mut on_narrow, mut narrow_sides, mut total) = (0usize, 0usize, 0usize);
+    // Samples on narrow sides, by material: what to simplify first.
+    let mut by_material = vec![0usize; scene.materials().len()];
     for (side, &n) in first.iter().enumerate() {
         if n == 0 {
             continue;
@@ -424,6 +426,7 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
         if narrow[surface] {
             on_narrow += n;
             narrow_sides += 1;
+            by_material[surfaces[surface].material as usize] += n;
         } else {
             wide_samples += n;
             wide_area += area;
@@ -434,16 +437,32 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
     }
     let by_area = wide_samples as f64 / wide_area * sampled_area;
     let excess = 1.0 - by_area / total as f64;
-    (excess > MOSTLY_TESSELLATION).then(|| Finding {
+    if excess <= MOSTLY_TESSELLATION {
+        return None;
+    }
+    let mut most: Vec<(usize, usize)> = by_material
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|&(_, n)| n > 0)
+        .collect();
+    most.sort_by_key(|&(m, n)| (std::cmp::Reverse(n), m));
+    let materials = most
+        .iter()
+        .take(3)
+        .map(|&(m, n)| format!("'{}' {n}", scene.materials()[m].name))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Some(Finding {
         fatal: false,
         message: format!(
             "{:.0}% of the {total} first samples are there because surfaces are cut into \
              facets narrower than {NARROW} ε = {:.3} ({on_narrow} samples on {narrow_sides} such \
-             sides: the facets of columns, arches, mouldings, spheres): each facet is sampled on \
-             its own, once every ε along its length, so the samples, links and time follow the \
-             mesh's tessellation; by their area alone, at the density of the wider surfaces, \
-             about {:.0} would do. Fewer facets on the curved surfaces cost less; ε moves these \
-             samples only along the facets.",
+             sides, most in materials {materials}: the facets of columns, arches, mouldings, \
+             spheres): each facet is sampled on its own, once every ε along its length, so the \
+             samples, links and time follow the mesh's tessellation; by their area alone, at \
+             the density of the wider surfaces, about {:.0} would do. Fewer facets on the curved \
+             surfaces cost less; ε moves these samples only along the facets.",
             100.0 * excess,
             NARROW * eps,
             by_area

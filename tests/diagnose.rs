@@ -211,6 +211,12 @@ fn columns_of_narrow_facets_are_told_their_samples_follow_the_tessellation() {
     assert!(silent.is_none(), "square columns: {silent:?}");
     let told = told.expect("round columns: no finding");
     assert!(told.message.contains("tessellation") && !told.fatal);
+    // The columns' facets are all of the one material the hall has.
+    assert!(
+        told.message.contains("materials 'grey' "),
+        "{}",
+        told.message
+    );
     assert!(round > 2 * square, "{round} samples against {square}");
     let by_area: f64 = told
         .message
