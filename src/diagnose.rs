@@ -362,8 +362,9 @@ pub fn image(scene: &Scene, image: &crate::Image) -> Option<Finding> {
     })
 }
 
-/// A surface narrower than this many ε is sampled along its length only: a row of samples ε
-/// apart, however narrow.
+/// A surface narrower than this many ε holds about a row or two of samples ε apart along its
+/// length however narrow it is (dart throwing within it): its samples follow its length, not
+/// its area, so the density by area is read from the wider ones.
 const NARROW: f64 = 2.0;
 /// The share of the first samples beyond what the area asks for, above which [`samples`] says so.
 const MOSTLY_TESSELLATION: f64 = 0.5;
@@ -371,7 +372,7 @@ const MOSTLY_TESSELLATION: f64 = 0.5;
 const DENSITY_SAMPLES: usize = 100;
 
 /// The check on a finished solve: whether most of the first (Poisson-disk) samples are there
-/// because surfaces are cut into facets narrower than ε rather than because of their area.
+/// because surfaces are cut into facets narrower than 2 ε rather than because of their area.
 /// Each planar surface is sampled on its own, at least once and once every ε along its length,
 /// so a column of 48 facets 4 cm wide gets a row of samples on each facet: the samples, and the
 /// links and time with them, follow the mesh's tessellation, and ε moves them only along the
@@ -386,7 +387,8 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
         return None;
     }
     let surfaces = scene.surfaces();
-    // Each surface's width: its area over the longest side of its triangles' bounding box.
+    // Each surface's width: its area over its bounding box's diagonal, which for a strip is its
+    // length whichever way it lies (a box's longest side would read a diagonal strip wide).
     let mut lo = vec![Vec3::splat(f32::INFINITY); surfaces.len()];
     let mut hi = vec![Vec3::splat(f32::NEG_INFINITY); surfaces.len()];
     for t in scene.triangles() {
@@ -400,11 +402,12 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
         .iter()
         .enumerate()
         .map(|(k, surface)| {
-            let length = f64::from((hi[k] - lo[k]).max_element());
-            length > 0.0 && surface.area / length < NARROW * eps
+            let length = f64::from((hi[k] - lo[k]).length());
+            length.is_finite() && length > 0.0 && surface.area / length < NARROW * eps
         })
         .collect();
-    // First samples per side.
+    // The first round's samples only: the adaptive rounds add where light changes, which is
+    // work the scene asks for.
     let mut first = vec![0usize; 2 * surfaces.len()];
     for (k, &side) in s.side.iter().enumerate() {
         if let (Some(0), Some(n)) = (s.round.get(k), first.get_mut(side as usize)) {
@@ -437,7 +440,7 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
     }
     let by_area = wide_samples as f64 / wide_area * sampled_area;
     let excess = 1.0 - by_area / total as f64;
-    if excess <= MOSTLY_TESSELLATION {
+    if excess.is_nan() || excess <= MOSTLY_TESSELLATION {
         return None;
     }
     let mut most: Vec<(usize, usize)> = by_material
