@@ -362,10 +362,11 @@ pub fn image(scene: &Scene, image: &crate::Image) -> Option<Finding> {
     })
 }
 
-/// A surface narrower than this many ε holds about a row or two of samples ε apart along its
-/// length however narrow it is (dart throwing within it): its samples follow its length, not
-/// its area, so the density by area is read from the wider ones.
-const NARROW: f64 = 2.0;
+// A surface narrower than NARROW ε holds about a row or two of samples ε apart along its
+// length however narrow it is (dart throwing within it): its samples follow its length, not its
+// area, so the density by area is read from the wider ones. The width is the one the solver
+// joins facets by.
+use crate::sampling::pieces::NARROW;
 /// The share of the first samples beyond what the area asks for, above which [`samples`] says so.
 const MOSTLY_TESSELLATION: f64 = 0.5;
 /// The fewest first samples on wide surfaces from which their density is read.
@@ -387,25 +388,8 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
         return None;
     }
     let surfaces = scene.surfaces();
-    // Each surface's width: its area over its bounding box's diagonal, which for a strip is its
-    // length whichever way it lies (a box's longest side would read a diagonal strip wide).
-    let mut lo = vec![Vec3::splat(f32::INFINITY); surfaces.len()];
-    let mut hi = vec![Vec3::splat(f32::NEG_INFINITY); surfaces.len()];
-    for t in scene.triangles() {
-        let k = t.surface as usize;
-        for v in t.vertices {
-            lo[k] = lo[k].min(v);
-            hi[k] = hi[k].max(v);
-        }
-    }
-    let narrow: Vec<bool> = surfaces
-        .iter()
-        .enumerate()
-        .map(|(k, surface)| {
-            let length = f64::from((hi[k] - lo[k]).length());
-            length.is_finite() && length > 0.0 && surface.area / length < NARROW * eps
-        })
-        .collect();
+    let narrow = crate::sampling::pieces::narrow_surfaces(scene, NARROW * eps);
+    let joined = solution.field().layout.pieces().len() > 0;
     // The first round's samples only: the adaptive rounds add where light changes, which is
     // work the scene asks for.
     let mut first = vec![0usize; 2 * surfaces.len()];
@@ -462,13 +446,24 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
             "{:.0}% of the {total} first samples are there because surfaces are cut into \
              facets narrower than {NARROW} ε = {:.3} ({on_narrow} samples on {narrow_sides} such \
              sides, most in materials {materials}: the facets of columns, arches, mouldings, \
-             spheres): each facet is sampled on its own, once every ε along its length, so the \
+             spheres): each {} is sampled on its own, once every ε along its length, so the \
              samples, links and time follow the mesh's tessellation; by their area alone, at \
-             the density of the wider surfaces, about {:.0} would do. Fewer facets on the curved \
-             surfaces cost less; ε moves these samples only along the facets.",
+             the density of the wider surfaces, about {:.0} would do. {}ε moves these samples \
+             only along the facets.",
             100.0 * excess,
             NARROW * eps,
-            by_area
+            if joined {
+                "facet or piece of facets (joined where they bend by little)"
+            } else {
+                "facet"
+            },
+            by_area,
+            if joined {
+                "Fewer facets on the curved surfaces cost less. "
+            } else {
+                "Joining the facets into the curved pieces they make (the solver option \
+                 join_facets) samples them by their area; fewer facets cost less too. "
+            }
         ),
     })
 }

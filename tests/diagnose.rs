@@ -4,7 +4,7 @@
 mod common;
 
 use common::mirror::{facing_down, facing_up, v};
-use common::{backends, camera, material, Builder};
+use common::{backends, camera, hall_of_columns, material, Builder};
 use meshlight::diagnose::{before_solve, image, samples, Finding};
 use meshlight::solver::Options;
 use meshlight::Scene;
@@ -147,46 +147,6 @@ fn no_shipped_scene_raises_anything() {
         let scene = Scene::load(common::shipped(name)).unwrap();
         assert_eq!(findings(&scene), vec![], "{name}");
     }
-}
-
-/// A 6 × 4 × 6 m room with four columns 0.6 m across from floor to ceiling: round ones of
-/// `facets` facets facing out, or square ones (`facets` 0), and a lamp under the ceiling.
-fn hall_of_columns(facets: u32) -> Scene {
-    let mut b = Builder::default();
-    let grey = b.material(material("grey", 0.6, 0.0));
-    b.room(v(0.0, 0.0, 0.0), v(6.0, 4.0, 6.0), grey, &[]);
-    let (r, h) = (0.3f32, 4.0f32);
-    for (cx, cz) in [(2.0, 2.0), (4.0, 2.0), (2.0, 4.0), (4.0, 4.0)] {
-        if facets == 0 {
-            b.solid(v(cx - r, 0.0, cz - r), v(cx + r, h, cz + r), grey);
-            continue;
-        }
-        let at = |i: u32, y: f32| {
-            let a = std::f32::consts::TAU * i as f32 / facets as f32;
-            v(cx + r * a.cos(), y, cz + r * a.sin())
-        };
-        for i in 0..facets {
-            b.quad([at(i, 0.0), at(i, h), at(i + 1, h), at(i + 1, 0.0)], grey);
-        }
-    }
-    b.point_lights.push(meshlight::scene::PointLight {
-        position: v(3.0, 3.6, 3.0),
-        intensity: glam::Vec3::splat(20.0),
-    });
-    let scene = b.scene(camera(v(0.5, 1.6, 0.5), v(3.0, 1.5, 3.0), 32));
-    // Every column facet faces out, away from its axis.
-    let mut checked = 0;
-    for s in scene.surfaces().iter().filter(|s| s.normal.y.abs() < 0.5) {
-        let t = &scene.triangles()[s.triangles.start as usize];
-        let c = (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0;
-        let axis = v((c.x / 2.0).round() * 2.0, c.y, (c.z / 2.0).round() * 2.0);
-        if (0.2..0.5).contains(&(c - axis).length()) {
-            assert!(s.normal.dot(c - axis) > 0.0, "a facet faces its axis");
-            checked += 1;
-        }
-    }
-    assert_eq!(checked, 4 * facets.max(4), "column sides checked");
-    scene
 }
 
 #[test]

@@ -58,7 +58,7 @@ pub(crate) fn compute(
     } else {
         vec![0..0; sides]
     };
-    let layout = lay_cells(samples, maps, epsilon, threads, &redo, &kept)?;
+    let layout = lay_cells(samples, places.index(), maps, epsilon, threads, &redo, &kept)?;
     let mut stats = AreaStats {
         cells: layout.cells.len(),
         ..AreaStats::default()
@@ -127,6 +127,7 @@ impl Layout {
 /// the kept ones.
 fn lay_cells(
     samples: &Samples,
+    index: &crate::sampling::SideIndex,
     maps: &[SurfaceMap],
     epsilon: f32,
     threads: usize,
@@ -142,7 +143,11 @@ fn lay_cells(
         smallest[side as usize] = smallest[side as usize].min(d);
         count[side as usize] += 1;
     }
-    let active: Vec<usize> = (0..sides).filter(|&side| count[side] > 0).collect();
+    // A curved piece's sides without samples of their own have cells too: the piece's
+    // samples share them.
+    let active: Vec<usize> = (0..sides)
+        .filter(|&side| count[side] > 0 || index.piece_has_samples(side as u32))
+        .collect();
     let mut clipped: Vec<Clipped> = vec![(0.0, Vec::new()); active.len()];
     for_chunks(&mut clipped, 1, threads, |i, out| {
         let side = active[i];
@@ -150,7 +155,7 @@ fn lay_cells(
             return Ok(());
         }
         let map = &maps[surface_of(side as u32) as usize];
-        let cell = cell_size(map, epsilon.min(smallest[side]), count[side]);
+        let cell = cell_size(map, epsilon.min(smallest[side]), count[side].max(1));
         out[0].0 = cell;
         clip_cells(map, cell, &mut out[0].1);
         Ok(())

@@ -62,6 +62,20 @@ impl<'a> Interpolator<'a> {
         for (&side, &d) in s.side.iter().zip(&s.radius) {
             support[side as usize] = support[side as usize].max(SUPPORT * d);
         }
+        // A curved piece's sides reach all its samples.
+        let pieces = field.layout.pieces();
+        for p in 0..pieces.len() as u32 {
+            let sides = pieces.sides(p);
+            let most = sides
+                .iter()
+                .map(|&side| support.get(side as usize).copied().unwrap_or(0.0))
+                .fold(0.0f32, f32::max);
+            for &side in sides {
+                if let Some(r) = support.get_mut(side as usize) {
+                    *r = most;
+                }
+            }
+        }
         // A segment from a point within a kernel's support to its sample lies in the support's
         // disc: nothing crossing the band there, nothing can block it.
         let obstruction = field.layout.obstruction();
@@ -157,7 +171,9 @@ impl<'a> Interpolator<'a> {
                     // Where nothing stands within the kernel, or across the segment's box,
                     // the sample is in sight: no query.
                     let to = s.uv[k as usize];
+                    // A sample of another side lies on the same curved piece, seen along it.
                     let open = self.clear[k as usize]
+                        || s.side[k as usize] != site.side
                         || !obstruction.may_block(site.side, uv.min(to), uv.max(to));
                     segments.push((!open).then(|| Segment {
                         a: from,
@@ -242,6 +258,10 @@ impl<'a> Interpolator<'a> {
             self.field.layout.index().within(s, side, uv, r, &mut near);
             near.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
             near.truncate(16);
+            // A sample of another side lies on the same curved piece: seen along it.
+            if let Some(&(k, _)) = near.first().filter(|n| s.side[n.0 as usize] != side) {
+                return Ok((Some(k), queries));
+            }
             let segments: Vec<Segment> = near
                 .iter()
                 .map(|&(k, _)| Segment {

@@ -1,5 +1,6 @@
 //! Where the samples lie (see [`Layout`]).
 
+use super::pieces::Pieces;
 use super::{vec_bytes, Obstruction, Samples, SideIndex, SurfaceMap};
 
 /// Where the samples lie, beyond the samples themselves: the surfaces in 2D, the samples' index,
@@ -18,18 +19,31 @@ pub(crate) struct Layout {
     obstruction: Obstruction,
     /// Per sample: whether something hovers over it (see `sampling::cover`).
     covered: Vec<bool>,
+    /// The narrow sides sampled, indexed and interpolated as curved pieces.
+    pieces: Pieces,
 }
 
 impl Layout {
     /// The layout of a solve that has placed no samples yet.
-    pub(crate) fn new(epsilon: f32, maps: Vec<SurfaceMap>, obstruction: Obstruction) -> Layout {
+    pub(crate) fn new(
+        epsilon: f32,
+        maps: Vec<SurfaceMap>,
+        obstruction: Obstruction,
+        pieces: Pieces,
+    ) -> Layout {
         Layout {
             epsilon,
             maps,
             index: SideIndex::default(),
             obstruction,
             covered: Vec::new(),
+            pieces,
         }
+    }
+
+    /// The curved pieces (none unless the solve joins narrow sides).
+    pub(crate) fn pieces(&self) -> &Pieces {
+        &self.pieces
     }
 
     /// The surfaces in 2D, one per surface.
@@ -54,7 +68,7 @@ impl Layout {
 
     /// Indexes `samples` anew (after samples were added).
     pub(crate) fn reindex(&mut self, samples: &Samples) {
-        self.index = SideIndex::new(samples, &self.maps, self.epsilon);
+        self.index = SideIndex::new(samples, &self.maps, self.epsilon, &self.pieces);
     }
 
     /// The Poisson-disk spacing ε.
@@ -74,10 +88,10 @@ impl Layout {
         self.covered.extend_from_slice(flags);
     }
 
-    /// Bytes of the index, the cover flags and the maps.
+    /// Bytes of the index (with the pieces), the cover flags and the maps.
     pub(crate) fn bytes(&self) -> (usize, usize, usize) {
         (
-            self.index.bytes(),
+            self.index.bytes() + self.pieces.bytes(),
             vec_bytes(&self.covered),
             self.maps.iter().map(|m| vec_bytes(&m.triangles)).sum(),
         )

@@ -4,6 +4,7 @@
 
 pub mod adaptive;
 pub(crate) mod cover;
+pub(crate) mod pieces;
 pub(crate) mod directions;
 pub mod free_path;
 mod layout;
@@ -295,7 +296,9 @@ impl Samples {
             }
             for &(j, d2) in &near {
                 let limit = d.min(self.radius[j as usize]) * (1.0 - 1e-3);
-                if j as usize != k && d2 < limit * limit {
+                // Across a piece's sides only the first round keeps its spacing (adaptive
+                // samples are placed side by side).
+                if j as usize != k && self.side[j as usize] == side && d2 < limit * limit {
                     return Err(format!(
                         "samples {k} and {j} lie {} apart, closer than their radii allow ({limit})",
                         d2.sqrt()
@@ -320,7 +323,8 @@ impl Samples {
                         "sample {k} holds a share of cell {c}, which does not exist"
                     ));
                 }
-                if !self.cells_of(self.side[k]).contains(&(c as usize)) {
+                let cell_side = self.side_of_cell(c as usize);
+                if cell_side != self.side[k] && !index.together(cell_side, self.side[k]) {
                     return Err(format!(
                         "sample {k} holds a share of a cell on another side"
                     ));
@@ -341,11 +345,27 @@ impl Samples {
                 return Err(format!("cell {c} of area {a} is shared out as {shared}"));
             }
         }
-        let per_side = self
+        let mut per_side = self
             .area_per_side(2 * maps.len())
             .map_err(|e| e.to_string())?;
+        // A piece's samples carry its sides' areas together: counted on its first side.
+        let expected_of = |side: usize| maps[surface_of(side as u32) as usize].area();
+        let mut piece_area = vec![0.0f64; 2 * maps.len()];
+        for side in 0..per_side.len() {
+            if let Some(first) = index.first_of_piece(side as u32) {
+                piece_area[first as usize] += expected_of(side);
+                if first as usize != side {
+                    per_side[first as usize] += per_side[side];
+                    per_side[side] = 0.0;
+                }
+            }
+        }
         for (side, &a) in per_side.iter().enumerate().filter(|(_, &a)| a > 0.0) {
-            let expected = maps[surface_of(side as u32) as usize].area();
+            let expected = if piece_area[side] > 0.0 {
+                piece_area[side]
+            } else {
+                expected_of(side)
+            };
             if (a - expected).abs() > 1e-3 * expected {
                 return Err(format!(
                     "side {side}'s samples carry {a} of its area {expected}"
@@ -364,6 +384,77 @@ pub struct SideIndex {
     /// Cell k's samples are entries[starts[k]..starts[k+1]].
     starts: Vec<u32>,
     entries: Vec<u32>,
+    /// The sides joined into curved pieces (`sampling::pieces`): a query on one of their sides
+    /// answers with the piece's samples by distance in 3D.
+    pieces: ByPiece,
+}
+
+/// The samples of each curved piece, and the frames that lift a side's 2D points to 3D.
+#[derive(Clone, Debug, Default)]
+struct ByPiece {
+    /// Per side: its piece, or `pieces::NONE` (empty: no pieces).
+    of_side: Vec<u32>,
+    /// Piece p's samples are `entries[starts[p]..starts[p + 1]]`, ascending.
+    starts: Vec<u32>,
+    entries: Vec<u32>,
+    /// Per surface: origin and in-plane axes of its map (empty: no pieces).
+    frames: Vec<[Vec3; 3]>,
+    /// Per piece: its first side.
+    first: Vec<Side>,
+}
+
+impl ByPiece {
+    fn new(samples: &Samples, maps: &[SurfaceMap], pieces: &pieces::Pieces) -> ByPiece {
+        if pieces.len() == 0 {
+            return ByPiece::default();
+        }
+        let of_side: Vec<u32> = (0..2 * maps.len() as u32)
+            .map(|side| pieces.of(side).unwrap_or(pieces::NONE))
+            .collect();
+        let mut starts = vec![0u32; pieces.len() + 1];
+        for &side in &samples.side {
+            if let Some(&p) = of_side.get(side as usize).filter(|&&p| p != pieces::NONE) {
+                starts[p as usize + 1] += 1;
+            }
+        }
+        for p in 0..pieces.len() {
+            starts[p + 1] += starts[p];
+        }
+        let mut next = starts.clone();
+        let mut entries = vec![0u32; starts[pieces.len()] as usize];
+        for (k, &side) in samples.side.iter().enumerate() {
+            if let Some(&p) = of_side.get(side as usize).filter(|&&p| p != pieces::NONE) {
+                entries[next[p as usize] as usize] = k as u32;
+                next[p as usize] += 1;
+            }
+        }
+        ByPiece {
+            of_side,
+            starts,
+            entries,
+            frames: maps.iter().map(|m| [m.origin, m.u, m.v]).collect(),
+            first: (0..pieces.len() as u32)
+                .map(|p| pieces.sides(p).first().copied().unwrap_or(0))
+                .collect(),
+        }
+    }
+
+    /// The piece of `side` and the 3D point of `uv` on it, if the side is in a piece.
+    fn lift(&self, side: Side, uv: Vec2) -> Option<(u32, Vec3)> {
+        let p = *self.of_side.get(side as usize)?;
+        let [o, u, v] = *self.frames.get(surface_of(side) as usize)?;
+        (p != pieces::NONE).then(|| (p, o + uv.x * u + uv.y * v))
+    }
+
+    fn samples(&self, p: u32) -> &[u32] {
+        let p = p as usize;
+        match (self.starts.get(p), self.starts.get(p + 1)) {
+            (Some(&a), Some(&b)) if a <= b && b as usize <= self.entries.len() => {
+                &self.entries[a as usize..b as usize]
+            }
+            _ => &[],
+        }
+    }
 }
 
 /// Bytes a vector holds.
@@ -374,7 +465,15 @@ pub(crate) fn vec_bytes<T>(v: &Vec<T>) -> usize {
 impl SideIndex {
     /// Bytes the index holds.
     pub fn bytes(&self) -> usize {
-        vec_bytes(&self.grids) + vec_bytes(&self.starts) + vec_bytes(&self.entries)
+        let p = &self.pieces;
+        vec_bytes(&self.grids)
+            + vec_bytes(&self.starts)
+            + vec_bytes(&self.entries)
+            + vec_bytes(&p.of_side)
+            + vec_bytes(&p.starts)
+            + vec_bytes(&p.entries)
+            + vec_bytes(&p.frames)
+            + vec_bytes(&p.first)
     }
 
     /// Whether the index holds no more sides than `sides` and only samples below `samples`
@@ -382,6 +481,8 @@ impl SideIndex {
     pub fn fits(&self, sides: usize, samples: usize) -> bool {
         self.grids.len() <= sides
             && self.entries.iter().all(|&k| (k as usize) < samples)
+            && self.pieces.of_side.len() <= sides
+            && self.pieces.entries.iter().all(|&k| (k as usize) < samples)
             && self.starts.windows(2).all(|w| w[0] <= w[1])
             && self
                 .starts
@@ -400,10 +501,36 @@ struct Grid {
 }
 
 impl SideIndex {
+    /// Whether two sides lie in one curved piece.
+    pub(crate) fn together(&self, a: Side, b: Side) -> bool {
+        let of = |s: Side| self.pieces.of_side.get(s as usize).copied();
+        of(a).is_some_and(|p| p != pieces::NONE && of(b) == Some(p))
+    }
+
+    /// The first side of the curved piece `side` lies in, if any.
+    pub(crate) fn first_of_piece(&self, side: Side) -> Option<Side> {
+        let p = *self.pieces.of_side.get(side as usize)?;
+        self.pieces.first.get(p as usize).copied()
+    }
+
+    /// Whether `side` lies in a curved piece with samples.
+    pub(crate) fn piece_has_samples(&self, side: Side) -> bool {
+        self.pieces
+            .of_side
+            .get(side as usize)
+            .is_some_and(|&p| p != pieces::NONE && !self.pieces.samples(p).is_empty())
+    }
+
     /// Indexes the samples. A side's cells are `cell` wide (ε), narrower where adaptive rounds
     /// shrank radii (down to twice the smallest radius), but never more than about four per
-    /// sample of the side, so big sparse sides stay small.
-    pub fn new(samples: &Samples, maps: &[SurfaceMap], cell: f32) -> SideIndex {
+    /// sample of the side, so big sparse sides stay small. Sides in `pieces` are also
+    /// indexed by piece.
+    pub(crate) fn new(
+        samples: &Samples,
+        maps: &[SurfaceMap],
+        cell: f32,
+        pieces: &pieces::Pieces,
+    ) -> SideIndex {
         let sides = 2 * maps.len();
         let mut count = vec![0usize; sides];
         let mut smallest = vec![f32::INFINITY; sides];
@@ -453,12 +580,14 @@ impl SideIndex {
             grids,
             starts,
             entries: keys.into_iter().map(|(_, k)| k).collect(),
+            pieces: ByPiece::new(samples, maps, pieces),
         }
     }
 
     /// Calls `f(k)` for every sample k of `side` whose 2D position may lie within `r` of `uv`
     /// (a superset: callers check the distance). In ascending sample order within each cell.
-    pub fn for_each_near(&self, side: Side, uv: Vec2, r: f32, mut f: impl FnMut(u32)) {
+    /// Sides in pieces are not asked here (see [`SideIndex::within`]).
+    fn for_each_near(&self, side: Side, uv: Vec2, r: f32, mut f: impl FnMut(u32)) {
         let Some(Some(g)) = self.grids.get(side as usize) else {
             return;
         };
@@ -476,7 +605,8 @@ impl SideIndex {
         }
     }
 
-    /// The samples of `side` within distance `r` of `uv`, with their squared distances.
+    /// The samples of `side` within distance `r` of `uv`, with their squared distances; for a
+    /// side in a curved piece, the piece's samples within `r` in 3D (on any of its sides).
     pub fn within(
         &self,
         samples: &Samples,
@@ -487,6 +617,15 @@ impl SideIndex {
     ) {
         out.clear();
         let r2 = r * r;
+        if let Some((p, at)) = self.pieces.lift(side, uv) {
+            for &k in self.pieces.samples(p) {
+                let d2 = samples.position[k as usize].distance_squared(at);
+                if d2 <= r2 {
+                    out.push((k, d2));
+                }
+            }
+            return;
+        }
         self.for_each_near(side, uv, r, |k| {
             let d2 = samples.uv[k as usize].distance_squared(uv);
             if d2 <= r2 {
@@ -495,7 +634,8 @@ impl SideIndex {
         });
     }
 
-    /// The nearest sample of `side` to `uv` (searching outwards), if the side has any.
+    /// The nearest sample of `side` to `uv` (searching outwards), if the side has any; for a
+    /// side in a curved piece, the piece's nearest in 3D.
     pub fn nearest(&self, samples: &Samples, side: Side, uv: Vec2) -> Option<u32> {
         self.nearest_where(samples, side, uv, |_| true)
     }
@@ -508,6 +648,16 @@ impl SideIndex {
         uv: Vec2,
         keep: impl Fn(u32) -> bool,
     ) -> Option<u32> {
+        if let Some((p, at)) = self.pieces.lift(side, uv) {
+            let mut best: Option<(f32, u32)> = None;
+            for &k in self.pieces.samples(p) {
+                let d2 = samples.position[k as usize].distance_squared(at);
+                if keep(k) && best.is_none_or(|(b, bk)| d2 < b || (d2 == b && k < bk)) {
+                    best = Some((d2, k));
+                }
+            }
+            return best.map(|(_, k)| k);
+        }
         let g = (*self.grids.get(side as usize)?)?;
         let mut r = g.cell;
         let reach = g.cell * (g.nx.max(g.ny) as f32 + 2.0);

@@ -172,8 +172,11 @@ impl Obstruction {
         let asked: Vec<bool> = candidates
             .iter()
             .map(|&(k, _)| {
+                // A sample of another side is one of the same curved piece (the index finds
+                // no other), seen along the piece: a chord across a column's facets runs
+                // inside it.
                 let to = samples.uv[k as usize];
-                self.may_block(side, uv.min(to), uv.max(to))
+                samples.side[k as usize] == side && self.may_block(side, uv.min(to), uv.max(to))
             })
             .collect();
         let segments: Vec<Segment> = candidates

@@ -124,6 +124,20 @@ impl Parts {
         }
     }
 
+    /// A round column of `facets` flat facets (radius `radius`, `height` high, standing on
+    /// `base`), faces pointing out, its corners shared between neighbouring facets.
+    pub fn column(&mut self, base: Vec3, radius: f32, height: f32, facets: u32, material: u32) {
+        let at = |i: u32, y: f32| {
+            let a = std::f32::consts::TAU * (i % facets) as f32 / facets as f32;
+            base + Vec3::new(radius * a.cos(), y, radius * a.sin())
+        };
+        for i in 0..facets {
+            let (a, b, c, d) = (at(i, 0.0), at(i, height), at(i + 1, height), at(i + 1, 0.0));
+            self.triangle([a, b, c], material);
+            self.triangle([a, c, d], material);
+        }
+    }
+
     /// The scene, with a camera at `eye` looking at `at`.
     pub fn scene(self, eye: Vec3, at: Vec3) -> Scene {
         let parts = SceneParts {

@@ -481,6 +481,11 @@ fn solve_with(
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
     let obstruction = Obstruction::new(scene, &maps, lift);
+    let pieces = if options.join_facets {
+        crate::sampling::pieces::Pieces::find(scene, &sides, epsilon)
+    } else {
+        crate::sampling::pieces::Pieces::none(scene.surfaces.len())
+    };
     let mut solve = Solve {
         scene,
         vis,
@@ -516,7 +521,7 @@ fn solve_with(
 
     // Round 0: Poisson disk on every reflecting side.
     let t = Instant::now();
-    let samples = solve.initial_samples(&maps)?;
+    let samples = solve.initial_samples(&maps, &pieces)?;
     let mut solution = Solution {
         field: Field {
             samples,
@@ -526,7 +531,7 @@ fn solve_with(
             daylight: Vec::new(),
             specular_depth: options.specular_depth,
             specular: solve.specular.is_some(),
-            layout: Layout::new(epsilon, maps, obstruction),
+            layout: Layout::new(epsilon, maps, obstruction, pieces),
         },
         unshot: Vec::new(),
         epsilon_source,

@@ -69,6 +69,11 @@ pub struct Options {
     /// same error against the flat solve (MAE/mean 0.35% and 0.34%); at 179k samples 97.6 M
     /// links and 2.57 GB instead of 5.1 M and 0.71 GB (`docs/performance.md`).
     pub exact_visibility: bool,
+    /// Sample, index and interpolate narrow facets (narrower than 2ε) that meet along edges
+    /// at under 20°, of one material, as the curved piece they tessellate (a column, an
+    /// arch, a moulding): Poisson-disk spacing across the piece instead of a row of samples
+    /// along every facet, so the samples follow ε, not the tessellation. Off by default.
+    pub join_facets: bool,
     /// The memory budget, bytes: every large structure counts against it. The samples and
     /// their results are predicted before they are placed ([`BYTES_PER_SAMPLE`](crate::budget::BYTES_PER_SAMPLE) each) and a
     /// solve that would not fit is refused before allocating; adaptive rounds stop adding
@@ -142,6 +147,7 @@ impl Default for Options {
             max_samples: 2_000_000,
             cluster_threshold: DEFAULT_CLUSTER_THRESHOLD,
             exact_visibility: false,
+            join_facets: false,
             memory_budget: DEFAULT_MEMORY_BUDGET,
             specular_depth: DEFAULT_SPECULAR_DEPTH,
             specular_rays: 64,
@@ -478,6 +484,14 @@ pub const KNOBS: &[Knob] = &[
         check: anything,
     },
     Knob {
+        name: "join_facets",
+        help: "Sample narrow facets that bend by under 20° as the curved piece they make (a \
+               column, an arch), spaced by ε, not a row of samples per facet",
+        value: None,
+        parse: |o, t| number(t).map(|v| o.join_facets = v),
+        check: anything,
+    },
+    Knob {
         name: "specular_depth",
         help: "Specular bounces light may take between diffuse surfaces (mirror images of \
                lights, and chains through mirrors, glossy surfaces and glass); 0 makes specular \
@@ -570,6 +584,7 @@ mod tests {
             ("memory_budget", "3M"),
             ("cluster_threshold", "0.5"),
             ("exact_visibility", "true"),
+            ("join_facets", "true"),
             ("specular_depth", "3"),
             ("specular_rays", "9"),
             ("photons", "77"),
@@ -633,6 +648,10 @@ mod tests {
                 },
                 "exact_visibility" => Options {
                     exact_visibility: true,
+                    ..base.clone()
+                },
+                "join_facets" => Options {
+                    join_facets: true,
                     ..base.clone()
                 },
                 "specular_depth" => Options {

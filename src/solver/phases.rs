@@ -133,12 +133,29 @@ impl<'a> Solve<'a> {
 
     /// Poisson-disk samples on every side light reaches (eq. 3), each side seeded on its own. A
     /// Stop leaves the sides not reached yet without samples.
-    pub(super) fn initial_samples(&mut self, maps: &[SurfaceMap]) -> Result<Samples> {
+    pub(super) fn initial_samples(
+        &mut self,
+        maps: &[SurfaceMap],
+        pieces: &crate::sampling::pieces::Pieces,
+    ) -> Result<Samples> {
         self.begin(Phase::Sampling, 0, 0);
         let sides = &self.sides;
         let mut per_side: Vec<Vec<glam::Vec2>> = vec![Vec::new(); sides.len()];
         let (epsilon, seed) = (self.epsilon, self.options.seed);
         let threads = self.options.threads.max(1);
+        // The curved pieces' points, thrown over each piece as a whole, by side (every rank
+        // throws them all: they are few beside the sides').
+        let mut by_piece: Vec<Vec<(u32, glam::Vec2)>> = vec![Vec::new(); pieces.len()];
+        if !self.reporter.stopped() {
+            crate::parallel::for_chunks(&mut by_piece, 1, threads, |p, out| {
+                out[0] = crate::sampling::pieces::sample_piece(pieces, p as u32, maps, epsilon, seed);
+                Ok(())
+            })?;
+        }
+        let mut from_pieces: std::collections::HashMap<u32, Vec<glam::Vec2>> = Default::default();
+        for (side, uv) in by_piece.into_iter().flatten() {
+            from_pieces.entry(side).or_default().push(uv);
+        }
         if !self.reporter.stopped() {
             let base = self.base(Phase::Sampling, 0, 0);
             // Over several ranks, each places the sides it deals.
@@ -148,8 +165,11 @@ impl<'a> Solve<'a> {
                     return Ok(());
                 }
                 let side = sides[i];
-                out[0] =
-                    poisson::sample_side(&maps[surface_of(side) as usize], side, epsilon, seed);
+                out[0] = if pieces.of(side).is_some() {
+                    from_pieces.get(&side).cloned().unwrap_or_default()
+                } else {
+                    poisson::sample_side(&maps[surface_of(side) as usize], side, epsilon, seed)
+                };
                 Ok(())
             };
             for_chunks_reporting(
@@ -713,6 +733,15 @@ impl<'a> Solve<'a> {
         for k in 0..samples.len() {
             if radii.get(k) != Some(&samples.radius[k]) {
                 changed[samples.side[k] as usize] = true;
+            }
+        }
+        // A piece's cells are shared among all its samples: a change anywhere redoes it all.
+        let pieces = solution.field.layout.pieces();
+        for p in 0..pieces.len() as u32 {
+            if pieces.sides(p).iter().any(|&s| changed[s as usize]) {
+                for &s in pieces.sides(p) {
+                    changed[s as usize] = true;
+                }
             }
         }
         Ok(Some(AddedSamples {
