@@ -62,7 +62,10 @@ fn joined_facets_take_the_samples_their_area_asks_and_carry_all_of_it() {
         // its 1.9 m of girth asks at ε spacing, on a fifth of the hall's area: about 1.25 ×.
         // Apart, 96 rows (measured 5,750 against 2,273 asked; joined 2,809).
         eprintln!("{backend}: apart {apart}, joined {joined}, asked {asked:.0}");
-        assert!(apart as f64 > 2.0 * asked, "apart {apart}, asked {asked:.0}");
+        assert!(
+            apart as f64 > 2.0 * asked,
+            "apart {apart}, asked {asked:.0}"
+        );
         assert!(
             (joined as f64) < 1.35 * asked,
             "joined {joined} against {asked:.0} asked"
@@ -104,4 +107,21 @@ fn joined_facets_light_the_hall_as_the_path_tracer_does() {
         // 4.43%, apart 4.23%; means −0.27% and −0.43%).
         assert!(j.mae_over_mean < a.mae_over_mean + 0.005, "{backend}");
     }
+}
+
+#[test]
+fn joined_facets_give_the_same_numbers_on_one_thread_or_two() {
+    let scene = hall_of_columns(96);
+    let backend = backends()[0];
+    let run = |threads| {
+        let o = Options {
+            threads,
+            ..options(true, 1)
+        };
+        common::solve(&scene, backend, o)
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.samples().position(), two.samples().position());
+    assert_eq!(one.samples().area(), two.samples().area());
+    assert_eq!(one.radiosity(), two.radiosity());
 }

@@ -58,7 +58,15 @@ pub(crate) fn compute(
     } else {
         vec![0..0; sides]
     };
-    let layout = lay_cells(samples, places.index(), maps, epsilon, threads, &redo, &kept)?;
+    let layout = lay_cells(
+        samples,
+        places.index(),
+        maps,
+        epsilon,
+        threads,
+        &redo,
+        &kept,
+    )?;
     let mut stats = AreaStats {
         cells: layout.cells.len(),
         ..AreaStats::default()

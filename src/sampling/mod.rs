@@ -4,12 +4,12 @@
 
 pub mod adaptive;
 pub(crate) mod cover;
-pub(crate) mod pieces;
 pub(crate) mod directions;
 pub mod free_path;
 mod layout;
 pub mod lit;
 pub mod obstruction;
+pub(crate) mod pieces;
 pub mod poisson;
 pub(crate) mod reflectance;
 pub(crate) mod shares;

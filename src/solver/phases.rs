@@ -148,7 +148,8 @@ impl<'a> Solve<'a> {
         let mut by_piece: Vec<Vec<(u32, glam::Vec2)>> = vec![Vec::new(); pieces.len()];
         if !self.reporter.stopped() {
             crate::parallel::for_chunks(&mut by_piece, 1, threads, |p, out| {
-                out[0] = crate::sampling::pieces::sample_piece(pieces, p as u32, maps, epsilon, seed);
+                out[0] =
+                    crate::sampling::pieces::sample_piece(pieces, p as u32, maps, epsilon, seed);
                 Ok(())
             })?;
         }

@@ -309,11 +309,20 @@ pub fn assert_dark_room_is_dark(s: &meshlight::Solution, label: &str) {
 pub fn hall_of_columns(facets: u32) -> Scene {
     let mut b = Builder::default();
     let grey = b.material(material("grey", 0.6, 0.0));
-    b.room(Vec3::new(0.0, 0.0, 0.0), Vec3::new(6.0, 4.0, 6.0), grey, &[]);
+    b.room(
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(6.0, 4.0, 6.0),
+        grey,
+        &[],
+    );
     let (r, h) = (0.3f32, 4.0f32);
     for (cx, cz) in [(2.0, 2.0), (4.0, 2.0), (2.0, 4.0), (4.0, 4.0)] {
         if facets == 0 {
-            b.solid(Vec3::new(cx - r, 0.0, cz - r), Vec3::new(cx + r, h, cz + r), grey);
+            b.solid(
+                Vec3::new(cx - r, 0.0, cz - r),
+                Vec3::new(cx + r, h, cz + r),
+                grey,
+            );
             continue;
         }
         let at = |i: u32, y: f32| {
@@ -328,7 +337,11 @@ pub fn hall_of_columns(facets: u32) -> Scene {
         position: Vec3::new(3.0, 3.6, 3.0),
         intensity: glam::Vec3::splat(20.0),
     });
-    let scene = b.scene(camera(Vec3::new(0.5, 1.6, 0.5), Vec3::new(3.0, 1.5, 3.0), 32));
+    let scene = b.scene(camera(
+        Vec3::new(0.5, 1.6, 0.5),
+        Vec3::new(3.0, 1.5, 3.0),
+        32,
+    ));
     // Every column facet faces out, away from its axis.
     let mut checked = 0;
     for s in scene.surfaces().iter().filter(|s| s.normal.y.abs() < 0.5) {
