@@ -389,7 +389,8 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
     }
     let surfaces = scene.surfaces();
     let narrow = crate::sampling::pieces::narrow_surfaces(scene, NARROW * eps);
-    let joined = solution.field().layout.pieces().len() > 0;
+    let pieces = solution.field().layout.pieces();
+    let joined = pieces.joined();
     // The first round's samples only: the adaptive rounds add where light changes, which is
     // work the scene asks for.
     let mut first = vec![0usize; 2 * surfaces.len()];
@@ -402,12 +403,28 @@ pub fn samples(scene: &Scene, solution: &crate::Solution) -> Option<Finding> {
     let (mut on_narrow, mut narrow_sides, mut total) = (0usize, 0usize, 0usize);
     // Samples on narrow sides, by material: what to simplify first.
     let mut by_material = vec![0usize; scene.materials().len()];
+    // A curved piece's samples carry all its sides' area, those without samples of their own
+    // too.
+    let piece_sampled: Vec<bool> = (0..pieces.len() as u32)
+        .map(|p| {
+            pieces
+                .sides(p)
+                .iter()
+                .any(|&side| first.get(side as usize).is_some_and(|&n| n > 0))
+        })
+        .collect();
     for (side, &n) in first.iter().enumerate() {
-        if n == 0 {
-            continue;
-        }
         let surface = crate::sampling::surface_of(side as u32) as usize;
         let area = surfaces[surface].area;
+        if n == 0 {
+            let in_sampled_piece = pieces
+                .of(side as u32)
+                .is_some_and(|p| piece_sampled.get(p as usize) == Some(&true));
+            if in_sampled_piece {
+                sampled_area += area;
+            }
+            continue;
+        }
         total += n;
         sampled_area += area;
         if narrow[surface] {

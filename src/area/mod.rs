@@ -52,6 +52,27 @@ pub(crate) fn compute(
 ) -> Result<AreaStats> {
     let (maps, epsilon, threads) = (places.maps(), places.epsilon(), exec.threads);
     let sides = 2 * maps.len();
+    // A curved piece's cells are shared among all its samples: a change on any of its sides
+    // redoes them all.
+    let changed: Option<Vec<bool>> = changed.map(|c| {
+        let mut widened = c.to_vec();
+        let pieces = places.pieces();
+        for p in 0..pieces.len() as u32 {
+            let any = pieces
+                .sides(p)
+                .iter()
+                .any(|&s| c.get(s as usize).copied().unwrap_or(true));
+            if any {
+                for &s in pieces.sides(p) {
+                    if let Some(w) = widened.get_mut(s as usize) {
+                        *w = true;
+                    }
+                }
+            }
+        }
+        widened
+    });
+    let changed = changed.as_deref();
     let redo = |side: usize| changed.is_none_or(|c| c.get(side).copied().unwrap_or(true));
     let kept = if changed.is_some() {
         previous_cells(samples, sides)

@@ -10,7 +10,7 @@ use glam::{DVec2, Vec2, Vec3};
 
 use super::Field;
 use crate::error::Result;
-use crate::sampling::{cover, is_back, surface_of, Side};
+use crate::sampling::{cover, is_back, surface_of, Obstruction, Side};
 use crate::scene::Scene;
 use crate::visibility::{Segment, Visibility};
 
@@ -169,15 +169,31 @@ impl<'a> Interpolator<'a> {
                 if q < 1.0 {
                     candidates.push((k, (1.0 - q).powi(3)));
                     // Where nothing stands within the kernel, or across the segment's box,
-                    // the sample is in sight: no query.
+                    // the sample is in sight: no query. A sample of another side lies on the
+                    // same curved piece: something may stand on either side.
                     let to = s.uv[k as usize];
-                    // A sample of another side lies on the same curved piece, seen along it.
-                    let open = self.clear[k as usize]
-                        || s.side[k as usize] != site.side
-                        || !obstruction.may_block(site.side, uv.min(to), uv.max(to));
-                    segments.push((!open).then(|| Segment {
-                        a: from,
-                        b: s.position[k as usize] + self.lift * s.normal[k as usize],
+                    let open = if s.side[k as usize] == site.side {
+                        self.clear[k as usize]
+                            || !obstruction.may_block(site.side, uv.min(to), uv.max(to))
+                    } else {
+                        !obstruction.may_block_between(
+                            self.field.layout.maps(),
+                            s,
+                            site.side,
+                            site.point,
+                            k,
+                        )
+                    };
+                    let (to, n) = (s.position[k as usize], s.normal[k as usize]);
+                    segments.push((!open).then(|| {
+                        if s.side[k as usize] == site.side {
+                            Segment {
+                                a: from,
+                                b: to + self.lift * n,
+                            }
+                        } else {
+                            Obstruction::lifted(self.lift, site.point, site.normal, to, n)
+                        }
                     }));
                 }
             }
@@ -258,15 +274,28 @@ impl<'a> Interpolator<'a> {
             self.field.layout.index().within(s, side, uv, r, &mut near);
             near.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
             near.truncate(16);
-            // A sample of another side lies on the same curved piece: seen along it.
-            if let Some(&(k, _)) = near.first().filter(|n| s.side[n.0 as usize] != side) {
+            // A sample of another side lies on the same curved piece: seen along it where
+            // nothing stands on either side between (a ray would cut a convex piece).
+            let obstruction = self.field.layout.obstruction();
+            let maps = self.field.layout.maps();
+            if let Some(&(k, _)) = near.iter().find(|n| {
+                s.side[n.0 as usize] != side
+                    && !obstruction.may_block_between(maps, s, side, point, n.0)
+            }) {
                 return Ok((Some(k), queries));
             }
             let segments: Vec<Segment> = near
                 .iter()
-                .map(|&(k, _)| Segment {
-                    a: from,
-                    b: s.position[k as usize] + self.lift * s.normal[k as usize],
+                .map(|&(k, _)| {
+                    let (to, n) = (s.position[k as usize], s.normal[k as usize]);
+                    if s.side[k as usize] == side {
+                        Segment {
+                            a: from,
+                            b: to + self.lift * n,
+                        }
+                    } else {
+                        Obstruction::lifted(self.lift, point, normal, to, n)
+                    }
                 })
                 .collect();
             let mut blocked = vec![false; segments.len()];

@@ -184,7 +184,13 @@ fn regions(field: &Field, vis: &dyn Visibility) -> Result<Vec<u32>> {
         if obstruction.is_obstructed(side) {
             let reach = NEIGHBOURS * s.radius[k as usize];
             index.within(s, side, s.uv[k as usize], reach, &mut near);
-            pairs.extend(near.iter().filter(|&&(j, _)| j > k).map(|&(j, _)| (k, j)));
+            // A region's table is in its side's frame: a curved piece's other sides keep their
+            // own regions.
+            pairs.extend(
+                near.iter()
+                    .filter(|&&(j, _)| j > k && s.side[j as usize] == side)
+                    .map(|&(j, _)| (k, j)),
+            );
         } else if first_of[side as usize] == u32::MAX {
             first_of[side as usize] = k;
         } else {

@@ -296,9 +296,13 @@ impl Samples {
             }
             for &(j, d2) in &near {
                 let limit = d.min(self.radius[j as usize]) * (1.0 - 1e-3);
-                // Across a piece's sides only the first round keeps its spacing (adaptive
-                // samples are placed side by side).
-                if j as usize != k && self.side[j as usize] == side && d2 < limit * limit {
+                // Across a curved piece's sides the first round keeps its spacing, and new
+                // samples keep it from old ones; only one round's new samples on two sides
+                // are placed apart (side by side).
+                let apart = self.side[j as usize] != side
+                    && self.round[j as usize] == self.round[k]
+                    && self.round[k] > 0;
+                if j as usize != k && !apart && d2 < limit * limit {
                     return Err(format!(
                         "samples {k} and {j} lie {} apart, closer than their radii allow ({limit})",
                         d2.sqrt()

@@ -139,6 +139,58 @@ impl Obstruction {
             .is_some_and(|p| p.as_ref().is_none_or(|p| !p.is_empty()))
     }
 
+    /// Whether something crossing a band may block the segment from `point` (on `side`) to
+    /// sample `k`: in `side`'s band, and for a sample on another side of the same curved piece
+    /// in that side's band too (a floor a column passes through crosses every facet's band,
+    /// and the piece's own facets cross none of a convex piece's).
+    pub(crate) fn may_block_between(
+        &self,
+        maps: &[SurfaceMap],
+        samples: &Samples,
+        side: Side,
+        point: Vec3,
+        k: u32,
+    ) -> bool {
+        let (Some(&other), Some(&to), Some(&at)) = (
+            samples.side.get(k as usize),
+            samples.uv.get(k as usize),
+            samples.position.get(k as usize),
+        ) else {
+            return true;
+        };
+        let frame = |s: Side| &maps[super::surface_of(s) as usize];
+        let from = frame(side).to_2d(point);
+        if other == side {
+            return self.may_block(side, from.min(to), from.max(to));
+        }
+        let (here, there) = (frame(side).to_2d(at), frame(other).to_2d(point));
+        self.may_block(side, from.min(here), from.max(here))
+            || self.may_block(other, there.min(to), there.max(to))
+    }
+
+    /// The segment between a point (of normal `normal`) and sample `k`, each lifted along its
+    /// own normal: by the lift, and where the two normals differ (a sample on another side of
+    /// a curved piece) by the most a chord between them dips under a convex piece as well,
+    /// d/2 · tan(φ/4) for normals φ apart, so the piece itself never blocks it.
+    pub(crate) fn lifted(
+        lift: f32,
+        point: Vec3,
+        normal: Vec3,
+        to: Vec3,
+        to_normal: Vec3,
+    ) -> Segment {
+        let cos = normal.dot(to_normal).clamp(-1.0, 1.0);
+        let extra = if cos < 1.0 - 1e-6 {
+            0.5 * point.distance(to) * (0.25 * cos.acos()).tan()
+        } else {
+            0.0
+        };
+        Segment {
+            a: point + (lift + extra) * normal,
+            b: to + (lift + extra) * to_normal,
+        }
+    }
+
     /// The segment between a point of a side and a sample, both lifted off the side.
     pub fn segment(&self, side_normal: Vec3, point: Vec3, samples: &Samples, k: u32) -> Segment {
         Segment {
@@ -158,7 +210,12 @@ impl Obstruction {
         point: Vec3,
         candidates: &mut Vec<(u32, T)>,
     ) -> Result<u64> {
-        if !self.is_obstructed(side) || candidates.is_empty() {
+        // A candidate on another side is one of the same curved piece (the index finds no
+        // other): something may stand on either side.
+        let across = |k: u32| samples.side.get(k as usize).is_some_and(|&s| s != side);
+        if candidates.is_empty()
+            || !self.is_obstructed(side) && !candidates.iter().any(|&(k, _)| across(k))
+        {
             return Ok(0);
         }
         let map = &maps[super::surface_of(side) as usize];
@@ -168,22 +225,22 @@ impl Obstruction {
             map.normal
         };
         // Only segments whose box something crosses the band in are asked.
-        let uv = map.to_2d(point);
         let asked: Vec<bool> = candidates
             .iter()
-            .map(|&(k, _)| {
-                // A sample of another side is one of the same curved piece (the index finds
-                // no other), seen along the piece: a chord across a column's facets runs
-                // inside it.
-                let to = samples.uv[k as usize];
-                samples.side[k as usize] == side && self.may_block(side, uv.min(to), uv.max(to))
-            })
+            .map(|&(k, _)| self.may_block_between(maps, samples, side, point, k))
             .collect();
         let segments: Vec<Segment> = candidates
             .iter()
             .zip(&asked)
             .filter(|(_, &a)| a)
-            .map(|(&(k, _), _)| self.segment(normal, point, samples, k))
+            .map(|(&(k, _), _)| {
+                if samples.side[k as usize] == side {
+                    self.segment(normal, point, samples, k)
+                } else {
+                    let (to, n) = (samples.position[k as usize], samples.normal[k as usize]);
+                    Self::lifted(self.lift, point, normal, to, n)
+                }
+            })
             .collect();
         let mut blocked = vec![false; segments.len()];
         vis.occluded(&segments, &mut blocked)?;

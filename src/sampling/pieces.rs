@@ -31,6 +31,10 @@ const BEND: f32 = 20.0;
 /// light arriving at its own normal, and on the shipped atrium a wider piece spreads it too
 /// far round a column (`docs/performance.md`: 45° gave 1.28% MAE/mean, 15° 1.09%).
 const CONE: f32 = 15.0;
+/// A piece holds at most this many ε² of area (some 180 first samples): queries scan a piece's
+/// samples, and a gently curved mesh of narrow facets (a vault, a terrain) would otherwise join
+/// into one piece of them all.
+const MAX_AREA: f64 = 256.0;
 /// No piece: the side is sampled, indexed and interpolated alone.
 pub(crate) const NONE: u32 = u32::MAX;
 
@@ -67,6 +71,8 @@ pub(crate) struct Pieces {
     /// Piece p's sides are `sides[start[p]..start[p + 1]]`.
     start: Vec<u32>,
     sides: Vec<Side>,
+    /// Whether the solve asked for pieces (it may have found none).
+    joined: bool,
 }
 
 impl Pieces {
@@ -76,6 +82,7 @@ impl Pieces {
             of_side: vec![NONE; 2 * surfaces],
             start: vec![0],
             sides: Vec::new(),
+            joined: false,
         }
     }
 
@@ -101,6 +108,7 @@ impl Pieces {
         let material = |side: Side| surfaces[surface_of(side) as usize].material;
         // Sides across each shared edge that may join (each pair both ways).
         let (bend, cone) = (BEND.to_radians().cos(), CONE.to_radians().cos());
+        let largest = MAX_AREA * f64::from(epsilon).powi(2);
         let mut next: Vec<Vec<Side>> = vec![Vec::new(); eligible.len()];
         for (a, b) in crate::scene::adjacency::shared_edges(scene) {
             for sa in [side_of(a, false), side_of(a, true)] {
@@ -127,17 +135,24 @@ impl Pieces {
             let p = start.len() as u32 - 1;
             let n0 = normal(seed as Side);
             let mut members = vec![seed as Side];
+            let area_of = |side: Side| surfaces[surface_of(side) as usize].area;
+            let mut area = area_of(seed as Side);
             of_side[seed] = p;
             queue.push_back(seed as Side);
             while let Some(s) = queue.pop_front() {
                 for &t in &next[s as usize] {
-                    if of_side[t as usize] == NONE && normal(t).dot(n0) >= cone {
+                    let fits = of_side[t as usize] == NONE
+                        && normal(t).dot(n0) >= cone
+                        && area + area_of(t) <= largest;
+                    if fits {
                         of_side[t as usize] = p;
+                        area += area_of(t);
                         members.push(t);
                         queue.push_back(t);
                     }
                 }
             }
+            queue.clear();
             if members.len() < 2 {
                 of_side[seed] = NONE;
                 continue;
@@ -150,7 +165,13 @@ impl Pieces {
             of_side,
             start,
             sides,
+            joined: true,
         }
+    }
+
+    /// Whether the solve asked for pieces (`Options::join_facets`), found or not.
+    pub(crate) fn joined(&self) -> bool {
+        self.joined
     }
 
     /// The piece of `side`, if it is in one.
@@ -172,7 +193,7 @@ impl Pieces {
 
     /// How many pieces.
     pub(crate) fn len(&self) -> usize {
-        self.start.len() - 1
+        self.start.len().saturating_sub(1)
     }
 
     /// Bytes held.
@@ -295,6 +316,25 @@ mod tests {
         assert_eq!(alone, 6);
         // At ε 0.01 the facets (3.9 cm wide) are wide: no pieces.
         assert_eq!(Pieces::find(&scene, &all_fronts(&scene), 0.01).len(), 0);
+    }
+
+    #[test]
+    fn a_piece_holds_at_most_its_share_of_area() {
+        // ε 0.05: each facet (3.9 cm × 4 m, 0.157 m²) is narrow, and 256 ε² = 0.64 m² holds
+        // four of them: a piece stops growing there, whatever its bend.
+        let scene = hall(48);
+        let eps = 0.05f32;
+        let pieces = Pieces::find(&scene, &all_fronts(&scene), eps);
+        assert!(pieces.len() >= 12, "{} pieces", pieces.len());
+        for p in 0..pieces.len() as u32 {
+            let sides = pieces.sides(p);
+            let area: f64 = sides
+                .iter()
+                .map(|&s| scene.surfaces()[surface_of(s) as usize].area)
+                .sum();
+            assert!((2..=4).contains(&sides.len()), "{} sides", sides.len());
+            assert!(area <= 256.0 * f64::from(eps * eps) + 1e-9, "{area} m²");
+        }
     }
 
     #[test]

@@ -736,15 +736,7 @@ impl<'a> Solve<'a> {
                 changed[samples.side[k] as usize] = true;
             }
         }
-        // A piece's cells are shared among all its samples: a change anywhere redoes it all.
-        let pieces = solution.field.layout.pieces();
-        for p in 0..pieces.len() as u32 {
-            if pieces.sides(p).iter().any(|&s| changed[s as usize]) {
-                for &s in pieces.sides(p) {
-                    changed[s as usize] = true;
-                }
-            }
-        }
+
         Ok(Some(AddedSamples {
             added: refinement.added,
             refined: refinement.refined,
