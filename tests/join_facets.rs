@@ -138,15 +138,8 @@ fn a_column_through_a_floor_carries_no_light_below_it() {
     let grey = b.material(common::material("grey", 0.6, 0.0));
     b.room(Vec3::ZERO, Vec3::new(6.0, 4.0, 6.0), grey, &[]);
     b.solid(Vec3::new(0.0, 1.95, 0.0), Vec3::new(6.0, 2.05, 6.0), grey);
-    let (r, h, facets) = (0.3f32, 4.0f32, 96u32);
     for (cx, cz) in [(2.0, 2.0), (4.0, 4.0)] {
-        let at = |i: u32, y: f32| {
-            let a = std::f32::consts::TAU * i as f32 / facets as f32;
-            Vec3::new(cx + r * a.cos(), y, cz + r * a.sin())
-        };
-        for i in 0..facets {
-            b.quad([at(i, 0.0), at(i, h), at(i + 1, h), at(i + 1, 0.0)], grey);
-        }
+        b.round_column(cx, cz, 0.3, 4.0, 96, grey);
     }
     b.point_lights.push(meshlight::scene::PointLight {
         position: Vec3::new(3.0, 3.6, 3.0),

@@ -149,6 +149,21 @@ impl Builder {
         }
     }
 
+    /// A round column of `facets` flat facets facing out, radius `r`, from the floor to `h`,
+    /// its axis at (cx, cz).
+    pub fn round_column(&mut self, cx: f32, cz: f32, r: f32, h: f32, facets: u32, material: u32) {
+        let at = |i: u32, y: f32| {
+            let a = std::f32::consts::TAU * i as f32 / facets as f32;
+            Vec3::new(cx + r * a.cos(), y, cz + r * a.sin())
+        };
+        for i in 0..facets {
+            self.quad(
+                [at(i, 0.0), at(i, h), at(i + 1, h), at(i + 1, 0.0)],
+                material,
+            );
+        }
+    }
+
     /// An axis-aligned box seen from outside (faces pointing out): a solid.
     pub fn solid(&mut self, lo: Vec3, hi: Vec3, material: u32) {
         let first = self.mesh.triangles.len();
@@ -325,13 +340,7 @@ pub fn hall_of_columns(facets: u32) -> Scene {
             );
             continue;
         }
-        let at = |i: u32, y: f32| {
-            let a = std::f32::consts::TAU * i as f32 / facets as f32;
-            Vec3::new(cx + r * a.cos(), y, cz + r * a.sin())
-        };
-        for i in 0..facets {
-            b.quad([at(i, 0.0), at(i, h), at(i + 1, h), at(i + 1, 0.0)], grey);
-        }
+        b.round_column(cx, cz, r, h, facets, grey);
     }
     b.point_lights.push(meshlight::scene::PointLight {
         position: Vec3::new(3.0, 3.6, 3.0),
