@@ -151,7 +151,7 @@ fn a_column_through_a_floor_carries_no_light_below_it() {
         let (solution, image) = solve_and_render(&scene, backend, options(true, 1), true);
         // The lower storey holds a trace of light, the facets apart too (the walls run
         // through the slab): its brightest pixel 4.8e-4 of the upper storey's radiance apart,
-        // 8.8e-4 joined; without the slab asked between a piece's sides, 1.0e-2.
+        // 9.0e-4 joined; without the slab asked between a piece's sides, 1.0e-2.
         let s = solution.samples();
         let above: Vec<f64> = (0..s.len())
             .filter(|&k| s.position()[k].y > 2.1)

@@ -521,7 +521,11 @@ impl Splitter<'_> {
         near: &mut Vec<(u32, f32)>,
         answers: &mut Answers,
     ) -> Result<()> {
-        if !self.obstruction.is_obstructed(side) || near.is_empty() {
+        // A candidate on another side lies on the same curved piece: asked too.
+        let across = near
+            .iter()
+            .any(|&(k, _)| self.samples.side[k as usize] != side);
+        if !self.obstruction.is_obstructed(side) && !across || near.is_empty() {
             return Ok(());
         }
         match answers {

@@ -278,10 +278,11 @@ impl<'a> Interpolator<'a> {
             // nothing stands on either side between (a ray would cut a convex piece).
             let obstruction = self.field.layout.obstruction();
             let maps = self.field.layout.maps();
-            if let Some(&(k, _)) = near.iter().find(|n| {
-                s.side[n.0 as usize] != side
-                    && !obstruction.may_block_between(maps, s, side, point, n.0)
-            }) {
+            if let Some(&(k, _)) = near
+                .iter()
+                .take_while(|n| s.side[n.0 as usize] != side)
+                .find(|n| !obstruction.may_block_between(maps, s, side, point, n.0))
+            {
                 return Ok((Some(k), queries));
             }
             let segments: Vec<Segment> = near

@@ -323,9 +323,29 @@ impl Shader<'_> {
             if radius[i] <= PATCH_CELLS * patches.cell(k) {
                 continue;
             }
-            let tested = obstruction.is_obstructed(site.side);
+            // The nearest sample may lie on another side of a curved piece.
+            let s = &field.samples;
+            let across = s
+                .side
+                .get(k as usize)
+                .is_some_and(|&side| side != site.side);
+            let tested = if across {
+                obstruction.may_block_between(field.layout.maps(), s, site.side, site.point, k)
+            } else {
+                obstruction.is_obstructed(site.side)
+            };
             if tested {
-                tests.push(obstruction.segment(site.normal, site.point, &field.samples, k));
+                tests.push(if across {
+                    crate::sampling::Obstruction::lifted(
+                        self.lift,
+                        site.point,
+                        site.normal,
+                        s.position[k as usize],
+                        s.normal[k as usize],
+                    )
+                } else {
+                    obstruction.segment(site.normal, site.point, s, k)
+                });
             }
             wide.push((i, k, tested));
         }

@@ -28,6 +28,9 @@ pub struct Obstruction {
     /// [`MAX_FOOTPRINTS`]. Empty for sides nothing crosses, which are the unobstructed ones.
     footprints: Vec<Option<Vec<(Vec2, Vec2)>>>,
     lift: f32,
+    /// Per side of a curved piece: whether anything crosses the band of any of the piece's
+    /// sides (a segment between two of its sides runs over the sides between). Empty: none.
+    piece_obstructed: Vec<bool>,
 }
 
 impl Obstruction {
@@ -116,7 +119,31 @@ impl Obstruction {
                 footprints[side_of(s as u32, back) as usize] = prints;
             }
         }
-        Obstruction { footprints, lift }
+        Obstruction {
+            footprints,
+            lift,
+            piece_obstructed: Vec::new(),
+        }
+    }
+
+    /// Notes, for each side of a curved piece, whether something stands on any of its sides.
+    pub(crate) fn with_pieces(mut self, pieces: &super::pieces::Pieces) -> Obstruction {
+        if pieces.len() == 0 {
+            return self;
+        }
+        let mut flags = vec![false; self.footprints.len()];
+        for p in 0..pieces.len() as u32 {
+            let sides = pieces.sides(p);
+            if sides.iter().any(|&s| self.is_obstructed(s)) {
+                for &s in sides {
+                    if let Some(f) = flags.get_mut(s as usize) {
+                        *f = true;
+                    }
+                }
+            }
+        }
+        self.piece_obstructed = flags;
+        self
     }
 
     /// Whether something crossing the side's band meets the (u, v) box `lo`..`hi` of its
@@ -140,9 +167,9 @@ impl Obstruction {
     }
 
     /// Whether something crossing a band may block the segment from `point` (on `side`) to
-    /// sample `k`: in `side`'s band, and for a sample on another side of the same curved piece
-    /// in that side's band too (a floor a column passes through crosses every facet's band,
-    /// and the piece's own facets cross none of a convex piece's).
+    /// sample `k`: in `side`'s band within the segment's box; for a sample on another side of
+    /// the same curved piece, anywhere on the piece (a floor a column passes through, a wall
+    /// meeting it; a convex piece's own facets cross none of its bands).
     pub(crate) fn may_block_between(
         &self,
         maps: &[SurfaceMap],
@@ -151,27 +178,33 @@ impl Obstruction {
         point: Vec3,
         k: u32,
     ) -> bool {
-        let (Some(&other), Some(&to), Some(&at)) = (
-            samples.side.get(k as usize),
-            samples.uv.get(k as usize),
-            samples.position.get(k as usize),
-        ) else {
+        let (Some(&other), Some(&to)) = (samples.side.get(k as usize), samples.uv.get(k as usize))
+        else {
             return true;
         };
-        let frame = |s: Side| &maps[super::surface_of(s) as usize];
-        let from = frame(side).to_2d(point);
-        if other == side {
-            return self.may_block(side, from.min(to), from.max(to));
+        if other != side {
+            // The segment runs over the piece's sides between the two: asked wherever
+            // anything stands on the piece.
+            return self
+                .piece_obstructed
+                .get(side as usize)
+                .copied()
+                .unwrap_or(true);
         }
-        let (here, there) = (frame(side).to_2d(at), frame(other).to_2d(point));
-        self.may_block(side, from.min(here), from.max(here))
-            || self.may_block(other, there.min(to), there.max(to))
+        let Some(map) = maps.get(super::surface_of(side) as usize) else {
+            return true;
+        };
+        let from = map.to_2d(point);
+        self.may_block(side, from.min(to), from.max(to))
     }
 
-    /// The segment between a point (of normal `normal`) and sample `k`, each lifted along its
-    /// own normal: by the lift, and where the two normals differ (a sample on another side of
-    /// a curved piece) by the most a chord between them dips under a convex piece as well,
-    /// d/2 · tan(φ/4) for normals φ apart, so the piece itself never blocks it.
+    /// The segment between a point (of normal `normal`) and a sample at `to` (of normal
+    /// `to_normal`), each lifted along its own normal. Where the two normals differ (a sample
+    /// on another side of a curved piece) the lift grows to clear the facets between: a chord
+    /// between two points of a convex run of facets with normals φ apart dips at most
+    /// d/2 · tan(φ/2) under them (the corner where the end facets' lines meet), and an end
+    /// lifted along its own normal rises by cos φ of that against the other end's facet:
+    /// (lift + d/2 · tan(φ/2)) / cos φ in all.
     pub(crate) fn lifted(
         lift: f32,
         point: Vec3,
@@ -180,14 +213,15 @@ impl Obstruction {
         to_normal: Vec3,
     ) -> Segment {
         let cos = normal.dot(to_normal).clamp(-1.0, 1.0);
-        let extra = if cos < 1.0 - 1e-6 {
-            0.5 * point.distance(to) * (0.25 * cos.acos()).tan()
+        let up = if cos < 1.0 - 1e-6 {
+            let half = 0.5 * cos.acos();
+            (lift + 0.5 * point.distance(to) * half.tan()) / cos.max(0.5)
         } else {
-            0.0
+            lift
         };
         Segment {
-            a: point + (lift + extra) * normal,
-            b: to + (lift + extra) * to_normal,
+            a: point + up * normal,
+            b: to + up * to_normal,
         }
     }
 

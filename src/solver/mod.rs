@@ -480,12 +480,12 @@ fn solve_with(
     refuse_too_many(scene, &sides, options, epsilon)?;
     let lift = crate::visibility::lift(scene);
     let maps = SurfaceMap::all(scene);
-    let obstruction = Obstruction::new(scene, &maps, lift);
     let pieces = if options.join_facets {
         crate::sampling::pieces::Pieces::find(scene, &sides, epsilon)
     } else {
         crate::sampling::pieces::Pieces::none(scene.surfaces.len())
     };
+    let obstruction = Obstruction::new(scene, &maps, lift).with_pieces(&pieces);
     let mut solve = Solve {
         scene,
         vis,

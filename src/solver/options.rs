@@ -73,9 +73,10 @@ pub struct Options {
     /// at under 20°, of one material, as the curved piece they tessellate (a column, an
     /// arch, a moulding): Poisson-disk spacing across the piece instead of a row of samples
     /// along every facet, so the samples follow ε, not the tessellation. Off by default. On
-    /// the shipped atrium 2.2 × faster, MAE/mean 1.26% against 1.09% and the worst 1% of
-    /// blocks 6.7% against 5.8%; with [`Options::epsilon_scale`] 0.7 as well, the same errors
-    /// in 0.65 of the time (`docs/performance.md`). Scenes without narrow facets: no effect.
+    /// the shipped atrium's solve 2.4 × faster; its image MAE/mean 1.27% against 1.09% and the
+    /// worst 1% of blocks 6.6% against 5.8%; with [`Options::epsilon_scale`] 0.7 as well,
+    /// about the same errors in 0.65 of the time (`docs/performance.md`). Scenes without narrow
+    /// facets: no effect.
     pub join_facets: bool,
     /// The memory budget, bytes: every large structure counts against it. The samples and
     /// their results are predicted before they are placed ([`BYTES_PER_SAMPLE`](crate::budget::BYTES_PER_SAMPLE) each) and a
