@@ -9,6 +9,10 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use crate::error::Result;
+// A surface narrower than NARROW ε holds about a row or two of samples ε apart along its length
+// however narrow it is (dart throwing within it): its samples follow its length, not its area, so
+// the density by area is read from the wider ones. The width is the one the solver joins facets by.
+use crate::sampling::pieces::NARROW;
 use crate::scene::Scene;
 use crate::visibility::{Hit, Ray, Visibility};
 
@@ -362,11 +366,6 @@ pub fn image(scene: &Scene, image: &crate::Image) -> Option<Finding> {
     })
 }
 
-// A surface narrower than NARROW ε holds about a row or two of samples ε apart along its
-// length however narrow it is (dart throwing within it): its samples follow its length, not its
-// area, so the density by area is read from the wider ones. The width is the one the solver
-// joins facets by.
-use crate::sampling::pieces::NARROW;
 /// The share of the first samples beyond what the area asks for, above which [`samples`] says so.
 const MOSTLY_TESSELLATION: f64 = 0.5;
 /// The fewest first samples on wide surfaces from which their density is read.

@@ -152,7 +152,6 @@ impl Pieces {
                     }
                 }
             }
-            queue.clear();
             if members.len() < 2 {
                 of_side[seed] = NONE;
                 continue;

@@ -736,7 +736,6 @@ impl<'a> Solve<'a> {
                 changed[samples.side[k] as usize] = true;
             }
         }
-
         Ok(Some(AddedSamples {
             added: refinement.added,
             refined: refinement.refined,
