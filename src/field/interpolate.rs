@@ -170,7 +170,7 @@ impl<'a> Interpolator<'a> {
                     candidates.push((k, (1.0 - q).powi(3)));
                     // Where nothing stands within the kernel, or across the segment's box,
                     // the sample is in sight: no query. A sample of another side lies on the
-                    // same curved piece: something may stand on either side.
+                    // same curved piece: something may stand on any side of the piece.
                     let to = s.uv[k as usize];
                     let open = if s.side[k as usize] == site.side {
                         self.clear[k as usize]
@@ -275,7 +275,7 @@ impl<'a> Interpolator<'a> {
             near.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
             near.truncate(16);
             // A sample of another side lies on the same curved piece: seen along it where
-            // nothing stands on either side between (a ray would cut a convex piece).
+            // nothing stands on any side of the piece (a straight ray would cut a convex one).
             let obstruction = self.field.layout.obstruction();
             let maps = self.field.layout.maps();
             if let Some(&(k, _)) = near

@@ -245,7 +245,7 @@ impl Obstruction {
         candidates: &mut Vec<(u32, T)>,
     ) -> Result<u64> {
         // A candidate on another side is one of the same curved piece (the index finds no
-        // other): something may stand on either side.
+        // other): something may stand on any side of the piece between the two.
         let across = |k: u32| samples.side.get(k as usize).is_some_and(|&s| s != side);
         if candidates.is_empty()
             || !self.is_obstructed(side) && !candidates.iter().any(|&(k, _)| across(k))
