@@ -1248,3 +1248,89 @@ fn a_path_trace_of_ten_million_samples_takes_passes_sized_by_time() {
         },
     );
 }
+
+// --- Facets many sides share: the solve's first steps stay short and hear a stop. ---
+
+/// Solves `scene` at `epsilon` (facets joined or apart), answering Stop once `stop` has passed;
+/// returns the result and how long the call took.
+fn stopped_solve(
+    scene: &Scene,
+    epsilon: f32,
+    join_facets: bool,
+    stop: Duration,
+) -> (meshlight::Result<meshlight::Solution>, Duration) {
+    let vis = Backend::Bvh.build(scene).unwrap();
+    let options = Options {
+        epsilon: Some(epsilon),
+        join_facets,
+        ..Options::default()
+    };
+    let start = Instant::now();
+    let r = meshlight::solve(scene, vis.as_ref(), &options, &mut |_| {
+        if start.elapsed() >= stop {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    });
+    (r, start.elapsed())
+}
+
+#[test]
+fn twenty_thousand_facets_fanned_around_one_edge_hear_a_stop_promptly() {
+    isolated(
+        "twenty_thousand_facets_fanned_around_one_edge_hear_a_stop_promptly",
+        || {
+            // Slivers 5 cm wide sharing one edge, each turned by 2π / n: every one lies in every
+            // other's box, and each crosses the band over half of the others. Looking through
+            // all of them for each side took 15 s before the first progress report (so before
+            // a stop could be heard); now a side stops looking after a bounded number of misses.
+            let n = 20_000u32;
+            let mut positions = vec![Vec3::ZERO, Vec3::Z];
+            let mut triangles = Vec::new();
+            for i in 0..n {
+                let a = std::f32::consts::TAU * i as f32 / n as f32;
+                positions.push(Vec3::new(0.05 * a.cos(), 0.05 * a.sin(), 0.5));
+                triangles.push([0, 1, i + 2]);
+            }
+            let scene = scene_of(positions, triangles).unwrap();
+            for join in [false, true] {
+                let (r, took) = stopped_solve(&scene, 0.1, join, Duration::ZERO);
+                println!("fan, joined {join}: stopped after {took:?}");
+                assert!(took < Duration::from_secs(6), "joined {join}: {took:?}");
+                assert_eq!(r.unwrap().validate(), Ok(()));
+            }
+        },
+    );
+}
+
+#[test]
+fn a_corrugated_sheet_of_narrow_facets_joins_in_bounded_time() {
+    isolated(
+        "a_corrugated_sheet_of_narrow_facets_joins_in_bounded_time",
+        || {
+            // 4,000 strips 1 cm wide and 4 m long, tilted ±5° in turn: one run of facets within
+            // the joining cone, far beyond a piece's cap of 256 ε².
+            let n = 4_000u32;
+            let mut positions = Vec::new();
+            let mut triangles = Vec::new();
+            let mut y = 0.0f32;
+            for i in 0..=n {
+                let x = 0.01 * i as f32;
+                positions.push(Vec3::new(x, y, 0.0));
+                positions.push(Vec3::new(x, y, 4.0));
+                y += if i % 2 == 0 { 0.000_87 } else { -0.000_87 };
+                if i < n {
+                    let k = 2 * i;
+                    triangles.push([k, k + 1, k + 2]);
+                    triangles.push([k + 2, k + 1, k + 3]);
+                }
+            }
+            let scene = scene_of(positions, triangles).unwrap();
+            let (r, took) = stopped_solve(&scene, 0.05, true, Duration::from_secs(2));
+            println!("sheet: stopped after {took:?}");
+            assert!(took < Duration::from_secs(8), "{took:?}");
+            assert_eq!(r.unwrap().validate(), Ok(()));
+        },
+    );
+}

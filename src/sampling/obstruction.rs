@@ -19,13 +19,20 @@ use crate::visibility::{Segment, Visibility};
 /// fewer than the footprints a test would scan).
 const MAX_FOOTPRINTS: usize = 256;
 
+/// Triangles a side may find in its band's box that do not cross the band before it stops
+/// looking and counts as crossed everywhere (every segment along it asked, as beyond
+/// [`MAX_FOOTPRINTS`]): thousands of facets fanned round one edge all lie in each other's
+/// boxes, and looking through all of them for every side took time quadratic in the facets.
+const MAX_MISSES: usize = 4 * MAX_FOOTPRINTS;
+
 /// Sides crossed by other geometry, where, and the lift used for point-to-point tests along
 /// sides.
 #[derive(Clone, Debug)]
 pub struct Obstruction {
     /// Per side: the (u, v) boxes, in its surface's frame, of the parts of the triangles
     /// crossing its band (grown by the lift), or none when there are more than
-    /// [`MAX_FOOTPRINTS`]. Empty for sides nothing crosses, which are the unobstructed ones.
+    /// [`MAX_FOOTPRINTS`] (or more than [`MAX_MISSES`] triangles in its box that do not cross
+    /// it). Empty for sides nothing crosses, which are the unobstructed ones.
     footprints: Vec<Option<Vec<(Vec2, Vec2)>>>,
     lift: f32,
     /// Per side of a curved piece: whether anything crosses the band of any of the piece's
@@ -73,6 +80,7 @@ impl Obstruction {
                 let base = normal.dot(map.origin);
                 let (klo, khi) = (key(blo), key(bhi));
                 let mut seen: Vec<u32> = Vec::new();
+                let mut misses = 0;
                 let mut prints: Option<Vec<(Vec2, Vec2)>> = Some(Vec::new());
                 'cells: for x in klo.x..=khi.x {
                     for y in klo.y..=khi.y {
@@ -111,6 +119,12 @@ impl Obstruction {
                                     }
                                     let part = in_band(&tri.vertices, h, reach);
                                     list.push(footprint(map, &part, lift));
+                                } else {
+                                    misses += 1;
+                                    if misses > MAX_MISSES {
+                                        prints = None;
+                                        break 'cells;
+                                    }
                                 }
                             }
                         }
@@ -402,5 +416,53 @@ mod tests {
             spared * 2 > tried,
             "only {spared} of {tried} segments spared a ray"
         );
+    }
+
+    #[test]
+    fn a_side_with_too_many_triangles_in_its_box_is_asked_everywhere() {
+        // A 4 m floor with `n` chips of 1 cm just under it: each lies in the floor's band box
+        // and none crosses its band. A few hundred leave the floor clear (no footprint); past
+        // MAX_MISSES the floor stops looking and counts as crossed everywhere, which asks more
+        // rays but can hide no wall.
+        let floor = |n: usize| {
+            let mut parts = Parts::default();
+            let white = parts.material(Material::diffuse("white", Vec3::splat(0.5), Vec3::ZERO));
+            let mut triangle = |t: [Vec3; 3]| {
+                let first = parts.mesh.positions.len() as u32;
+                parts.mesh.positions.extend(t);
+                parts.mesh.triangles.push([first, first + 1, first + 2]);
+                parts.mesh.triangle_materials.push(white);
+            };
+            let (o, x, z) = (Vec3::ZERO, Vec3::X * 4.0, Vec3::Z * 4.0);
+            triangle([o, o + z, o + x + z]);
+            triangle([o, o + x + z, o + x]);
+            let per_row = (n as f32).sqrt().ceil() as usize;
+            for i in 0..n {
+                let (r, c) = (i / per_row, i % per_row);
+                let p = Vec3::new(
+                    0.2 + 3.6 * c as f32 / per_row as f32,
+                    -1e-6,
+                    0.2 + 3.6 * r as f32 / per_row as f32,
+                );
+                triangle([p, p + Vec3::X * 0.01, p + Vec3::Z * 0.01]);
+            }
+            let scene = parts.scene(Vec3::new(2.0, 1.0, 2.0), Vec3::ZERO);
+            let maps = SurfaceMap::all(&scene);
+            let lift = crate::visibility::lift(&scene);
+            assert!(lift > 1e-5, "lift {lift}");
+            let obstruction = Obstruction::new(&scene, &maps, lift);
+            // The floor is the surface whose normal points up.
+            let s = maps
+                .iter()
+                .position(|m| m.normal.y > 0.9 && m.normal.dot(m.origin).abs() < 1e-3);
+            let side = side_of(s.unwrap() as u32, false);
+            (
+                obstruction.is_obstructed(side),
+                obstruction.may_block(side, Vec2::splat(0.1), Vec2::splat(0.2)),
+            )
+        };
+        assert_eq!(floor(400), (false, false));
+        const { assert!(2 * MAX_MISSES <= 2_500) };
+        assert_eq!(floor(2_500), (true, true));
     }
 }
