@@ -35,7 +35,7 @@ const MAX_PROBES: usize = 1024;
 /// Rays per probe point.
 const RAYS: usize = 8;
 /// Rays cast in one batch (the sides' probes are gathered until they pass this).
-const BATCH_RAYS: usize = 1 << 18;
+const BATCH_RAYS: usize = 1 << 16;
 /// Seed of the probes (fixed: the answer is the scene's, not the solve's).
 const SEED: u64 = 0x6c69_745f_7369_6465;
 
@@ -43,6 +43,18 @@ const SEED: u64 = 0x6c69_745f_7369_6465;
 /// the scene has daylight or specular surfaces, when none is two-sided, or when no light
 /// reaches any (a dark scene is said so elsewhere, on all its sides).
 pub fn lit_sides(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Side>> {
+    lit_sides_heard(scene, vis, &mut || false)
+}
+
+/// [`lit_sides`], asking `stop` after each batch of probes whether the host wants to stop:
+/// then the probing ends and every reflecting side is kept, as in a scene whose light reaches
+/// them all. (Probes in a mesh whose triangles all lie in each other's boxes, thousands of
+/// facets fanned round one edge, can take minutes.)
+pub(crate) fn lit_sides_heard(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    stop: &mut dyn FnMut() -> bool,
+) -> Result<Vec<Side>> {
     let all = reflecting_sides(scene);
     // Only the materials surfaces use: an MTL file may list a glass nothing is made of.
     let specular = scene
@@ -112,6 +124,9 @@ pub fn lit_sides(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Side>> {
             c += 1;
         }
         first = c;
+        if stop() {
+            return Ok(all);
+        }
         let mut blocked = vec![true; segments.len()];
         let only: Vec<Segment> = segments.iter().map(|s| s.1).collect();
         vis.occluded(&only, &mut blocked)?;
@@ -132,6 +147,9 @@ pub fn lit_sides(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Side>> {
                 reached[candidates[*c] as usize] = true;
             }
             seen_from[*c].push(met);
+        }
+        if stop() {
+            return Ok(all);
         }
     }
     for met in &mut seen_from {

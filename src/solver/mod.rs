@@ -475,7 +475,13 @@ fn solve_with(
     method: Method,
 ) -> Result<Solution> {
     options.validate()?;
-    let sides = lit_sides(scene, vis)?;
+    let mut reporter = Reporter::new(progress);
+    // Which sides light reaches is where the samples go: the host hears it as their placing.
+    let sides = crate::sampling::lit::lit_sides_heard(scene, vis, &mut || {
+        reporter.report(crate::progress::Progress::of(
+            crate::progress::Phase::Sampling,
+        ))
+    })?;
     let (epsilon, epsilon_source) = choose_epsilon_for(scene, vis, &sides, options)?;
     refuse_too_many(scene, &sides, options, epsilon)?;
     let lift = crate::visibility::lift(scene);
@@ -512,7 +518,7 @@ fn solve_with(
         lift,
         epsilon,
         sides,
-        reporter: Reporter::new(progress),
+        reporter,
         ranks,
         light_scale: glam::DVec3::ONE,
         interpolated: Vec::new(),
