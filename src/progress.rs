@@ -16,6 +16,9 @@ use std::time::Instant;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Phase {
+    /// Finding the sides light can reach, where samples will go (solve, in scenes with
+    /// two-sided faces).
+    Reach,
     /// Placing the initial samples (solve).
     Sampling,
     /// Computing representative areas (solve).
@@ -48,6 +51,7 @@ impl Phase {
     /// A few words for a progress line.
     pub fn describe(self) -> &'static str {
         match self {
+            Phase::Reach => "sides light reaches",
             Phase::Sampling => "placing samples",
             Phase::Areas => "representative areas",
             Phase::DirectLight => "direct light",

@@ -35,7 +35,7 @@ const MAX_PROBES: usize = 1024;
 /// Rays per probe point.
 const RAYS: usize = 8;
 /// Rays cast in one batch (the sides' probes are gathered until they pass this).
-const BATCH_RAYS: usize = 1 << 16;
+const BATCH_RAYS: usize = 1 << 14;
 /// Seed of the probes (fixed: the answer is the scene's, not the solve's).
 const SEED: u64 = 0x6c69_745f_7369_6465;
 
@@ -43,17 +43,18 @@ const SEED: u64 = 0x6c69_745f_7369_6465;
 /// the scene has daylight or specular surfaces, when none is two-sided, or when no light
 /// reaches any (a dark scene is said so elsewhere, on all its sides).
 pub fn lit_sides(scene: &Scene, vis: &dyn Visibility) -> Result<Vec<Side>> {
-    lit_sides_heard(scene, vis, &mut || false)
+    lit_sides_heard(scene, vis, &mut |_| false)
 }
 
-/// [`lit_sides`], asking `stop` after each batch of probes whether the host wants to stop:
-/// then the probing ends and every reflecting side is kept, as in a scene whose light reaches
-/// them all. (Probes in a mesh whose triangles all lie in each other's boxes, thousands of
-/// facets fanned round one edge, can take minutes.)
+/// [`lit_sides`], telling `stop` the share of the sides probed before each batch of probes and
+/// once all are, and hearing from it whether the host wants to stop: then the probing ends and
+/// every reflecting side is kept, as in a scene whose light reaches them all. (Probes in a
+/// mesh whose triangles all lie in each other's boxes, thousands of facets fanned round one
+/// edge, can take minutes.)
 pub(crate) fn lit_sides_heard(
     scene: &Scene,
     vis: &dyn Visibility,
-    stop: &mut dyn FnMut() -> bool,
+    stop: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Vec<Side>> {
     let all = reflecting_sides(scene);
     // Only the materials surfaces use: an MTL file may list a glass nothing is made of.
@@ -94,6 +95,9 @@ pub(crate) fn lit_sides_heard(
     let mut seen_from: Vec<Vec<Side>> = vec![Vec::new(); candidates.len()];
     let mut first = 0;
     while first < candidates.len() {
+        if stop(first as f64 / candidates.len() as f64) {
+            return Ok(all);
+        }
         let mut segments: Vec<(usize, Segment)> = Vec::new();
         let mut rays: Vec<(usize, Ray)> = Vec::new();
         let mut c = first;
@@ -124,9 +128,6 @@ pub(crate) fn lit_sides_heard(
             c += 1;
         }
         first = c;
-        if stop() {
-            return Ok(all);
-        }
         let mut blocked = vec![true; segments.len()];
         let only: Vec<Segment> = segments.iter().map(|s| s.1).collect();
         vis.occluded(&only, &mut blocked)?;
@@ -148,10 +149,8 @@ pub(crate) fn lit_sides_heard(
             }
             seen_from[*c].push(met);
         }
-        if stop() {
-            return Ok(all);
-        }
     }
+    stop(1.0);
     for met in &mut seen_from {
         met.sort_unstable();
         met.dedup();

@@ -62,6 +62,9 @@ impl Obstruction {
             }
         }
         let mut footprints = vec![Some(Vec::new()); 2 * maps.len()];
+        // Per triangle, the last side that looked at it (a triangle is listed in every grid
+        // cell its box meets, and counts once a side, as a footprint or as a miss).
+        let mut looked = vec![u32::MAX; scene.triangles.len()];
         for (s, map) in maps.iter().enumerate() {
             let surface = &scene.surfaces[s];
             let tris =
@@ -79,7 +82,7 @@ impl Obstruction {
                 );
                 let base = normal.dot(map.origin);
                 let (klo, khi) = (key(blo), key(bhi));
-                let mut seen: Vec<u32> = Vec::new();
+                let this = side_of(s as u32, back);
                 let mut misses = 0;
                 let mut prints: Option<Vec<(Vec2, Vec2)>> = Some(Vec::new());
                 'cells: for x in klo.x..=khi.x {
@@ -90,9 +93,10 @@ impl Obstruction {
                             };
                             for &t in list {
                                 let tri = &scene.triangles[t as usize];
-                                if tri.surface == s as u32 {
+                                if tri.surface == s as u32 || looked[t as usize] == this {
                                     continue;
                                 }
+                                looked[t as usize] = this;
                                 let (tlo, thi) = (
                                     tri.vertices[0].min(tri.vertices[1]).min(tri.vertices[2]),
                                     tri.vertices[0].max(tri.vertices[1]).max(tri.vertices[2]),
@@ -104,11 +108,6 @@ impl Obstruction {
                                 let (hmin, hmax) =
                                     (h[0].min(h[1]).min(h[2]), h[0].max(h[1]).max(h[2]));
                                 if hmax > 0.0 && hmin < reach {
-                                    // A triangle listed in several cells is one footprint.
-                                    if seen.contains(&t) {
-                                        continue;
-                                    }
-                                    seen.push(t);
                                     let Some(list) = prints.as_mut() else {
                                         break 'cells;
                                     };
@@ -130,7 +129,7 @@ impl Obstruction {
                         }
                     }
                 }
-                footprints[side_of(s as u32, back) as usize] = prints;
+                footprints[this as usize] = prints;
             }
         }
         Obstruction {
@@ -436,6 +435,11 @@ mod tests {
             let (o, x, z) = (Vec3::ZERO, Vec3::X * 4.0, Vec3::Z * 4.0);
             triangle([o, o + z, o + x + z]);
             triangle([o, o + x + z, o + x]);
+            // A 3 m sheet just under the floor too: two triangles listed in hundreds of grid
+            // cells, which count once each.
+            let (a, b) = (Vec3::new(0.5, -1e-6, 0.5), Vec3::new(3.5, -1e-6, 3.5));
+            triangle([a, Vec3::new(b.x, a.y, a.z), b]);
+            triangle([a, b, Vec3::new(a.x, a.y, b.z)]);
             let per_row = (n as f32).sqrt().ceil() as usize;
             for i in 0..n {
                 let (r, c) = (i / per_row, i % per_row);

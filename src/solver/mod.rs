@@ -476,11 +476,11 @@ fn solve_with(
 ) -> Result<Solution> {
     options.validate()?;
     let mut reporter = Reporter::new(progress);
-    // Which sides light reaches is where the samples go: the host hears it as their placing.
-    let sides = crate::sampling::lit::lit_sides_heard(scene, vis, &mut || {
-        reporter.report(crate::progress::Progress::of(
-            crate::progress::Phase::Sampling,
-        ))
+    let sides = crate::sampling::lit::lit_sides_heard(scene, vis, &mut |fraction| {
+        reporter.report(crate::progress::Progress {
+            fraction,
+            ..crate::progress::Progress::of(crate::progress::Phase::Reach)
+        })
     })?;
     let (epsilon, epsilon_source) = choose_epsilon_for(scene, vis, &sides, options)?;
     refuse_too_many(scene, &sides, options, epsilon)?;
