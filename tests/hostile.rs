@@ -144,6 +144,19 @@ fn refused<T: std::fmt::Debug>(case: &str, result: meshlight::Result<T>, words: 
 
 // --- Surface grouping: linear in the triangles whatever the mesh. ---
 
+/// `n` triangles sharing the edge (0,0,0)-(0,0,1), each turned by 2π / n about it, their third
+/// corners `radius` from it.
+fn fan(n: u32, radius: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut positions = vec![Vec3::ZERO, Vec3::Z];
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        let a = std::f32::consts::TAU * i as f32 / n as f32;
+        positions.push(Vec3::new(radius * a.cos(), radius * a.sin(), 0.5));
+        triangles.push([0, 1, i + 2]);
+    }
+    (positions, triangles)
+}
+
 #[test]
 fn ten_thousand_identical_triangles_group_in_bounded_time() {
     isolated(
@@ -166,13 +179,7 @@ fn a_hundred_thousand_triangles_fanned_around_one_edge_group_in_bounded_time() {
             // Every triangle shares the edge (0,0,0)-(0,0,1) and turns by 2π / n about it:
             // each in its own plane, so each its own surface.
             let n = 100_000u32;
-            let mut positions = vec![Vec3::ZERO, Vec3::Z];
-            let mut triangles = Vec::new();
-            for i in 0..n {
-                let a = std::f32::consts::TAU * i as f32 / n as f32;
-                positions.push(Vec3::new(a.cos(), a.sin(), 0.5));
-                triangles.push([0, 1, i + 2]);
-            }
+            let (positions, triangles) = fan(n, 1.0);
             let t = Instant::now();
             let scene = scene_of(positions, triangles).unwrap();
             println!("fan of {n}: {:.2} s", t.elapsed().as_secs_f64());
@@ -1298,14 +1305,7 @@ fn twenty_thousand_facets_fanned_around_one_edge_hear_a_stop_promptly() {
             // sliver's box) took 165 s before the first report; now the probing reports between
             // batches of 16,384 rays (under a second each here; with batches 4 times larger a
             // stop went unheard for 9 s).
-            let n = 20_000u32;
-            let mut positions = vec![Vec3::ZERO, Vec3::Z];
-            let mut triangles = Vec::new();
-            for i in 0..n {
-                let a = std::f32::consts::TAU * i as f32 / n as f32;
-                positions.push(Vec3::new(0.05 * a.cos(), 0.05 * a.sin(), 0.5));
-                triangles.push([0, 1, i + 2]);
-            }
+            let (positions, triangles) = fan(20_000, 0.05);
             for two_sided in [false, true] {
                 let scene = scene_sided(positions.clone(), triangles.clone(), two_sided).unwrap();
                 for join in [false, true] {
