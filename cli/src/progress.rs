@@ -149,10 +149,14 @@ fn line(what: &str, p: &Progress) -> String {
         _ => String::new(),
     };
     if what == "solve" {
-        format!(
-            "round {}: {phase}: {} samples{detail}{done}{left}",
-            p.round, p.items
-        )
+        // Before the first samples are placed (the probes for the sides light reaches, the
+        // first placing) there are none to count.
+        let samples = if p.items > 0 {
+            format!(": {} samples", p.items)
+        } else {
+            String::new()
+        };
+        format!("round {}: {phase}{samples}{detail}{done}{left}", p.round)
     } else {
         format!("{what}: {phase}{detail}{done}{left}")
     }

@@ -1013,6 +1013,8 @@ fn a_run_whose_stderr_is_a_log_prints_plain_progress_lines_unless_quiet() {
             && lines.iter().any(|l| l.contains("render: ")),
         "{log}"
     );
+    // No line counts samples before there are any.
+    assert!(!lines.iter().any(|l| l.contains(" 0 samples")), "{log}");
     let quiet = succeed(&[&args[..], &["--quiet"]].concat());
     assert!(
         !text(&quiet.stderr).lines().any(|l| l.contains(" s: round")),

@@ -88,6 +88,7 @@ impl<'a> Basis<'a> {
             grid: &grid,
             samples: &solution.field.samples,
             obstruction: solution.field.layout.obstruction(),
+            pieces: solution.field.layout.pieces(),
             lift: settings.lift,
         };
         let mut report = |_: Tick| {

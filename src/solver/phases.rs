@@ -685,6 +685,7 @@ impl<'a> Solve<'a> {
                     grid,
                     samples: state.samples,
                     obstruction: solution.field.layout.obstruction(),
+                    pieces: solution.field.layout.pieces(),
                     lift: self.lift,
                 };
                 cluster::shoot(&mut state, vis, &settings, &cx, &mut report)?

@@ -106,6 +106,8 @@ pub(crate) struct Context<'a> {
     pub grid: &'a TriangleGrid,
     pub samples: &'a Samples,
     pub obstruction: &'a Obstruction,
+    /// The curved pieces narrow sides were joined into (none unless the solve joins them).
+    pub pieces: &'a crate::sampling::pieces::Pieces,
     /// How far sample points are lifted off their surfaces: the tolerance of the tests.
     pub lift: f32,
 }
@@ -178,21 +180,32 @@ fn splits(normal: Vec3, point: Vec3, lo: Vec3, hi: Vec3, members: &[u32], cx: &C
     false
 }
 
-/// Whether something hovers close in front of the members of a one-side node (within `depth`
-/// of its plane, over their footprint): a light fixture under a ceiling, a canvas before a wall.
-/// Such a node may hold members that see a shooter and members sheltered from it, in a gap the
-/// probes of a faint link can miss; light is never averaged into it. Nodes over several sides
-/// count as sheltered.
+/// What a node's members lie on, as the hover tests see it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Owner {
+    /// One side.
+    Side(u32),
+    /// Several sides of one curved piece.
+    Piece(u32),
+    /// Sides of several surfaces or pieces.
+    Several,
+}
+
+/// Whether something hovers close in front of the members of a node on one side or one curved
+/// piece (within `depth` in front of the plane n · x = `base` through its lowest member, over
+/// their footprint): a light fixture under a ceiling, a canvas before a wall. Such a node may
+/// hold members that see a shooter and members sheltered from it, in a gap the probes of a faint
+/// link can miss; light is never averaged into it. A piece's own facets do not count (a vault's
+/// curve rises in front of its lowest member). Nodes over several sides of more than one
+/// surface or piece count as sheltered.
 pub(crate) fn sheltered(
     cx: &Context,
-    side: Option<u32>,
-    normal: Vec3,
+    owner: Owner,
+    (normal, base): (Vec3, f32),
     lo: Vec3,
     hi: Vec3,
     depth: f32,
 ) -> bool {
-    let Some(side) = side else { return true };
-    let surface = side / 2;
     // The members' box, shrunk across the plane by the lift (a wall meeting the side along the
     // footprint's edge does not shelter it), and reaching `depth` in front.
     let pad = Vec3::splat(cx.lift) * (Vec3::ONE - normal.abs());
@@ -200,8 +213,18 @@ pub(crate) fn sheltered(
         (lo + pad).min(lo + pad + depth * normal),
         (hi - pad).max(hi - pad + depth * normal),
     );
-    let base = normal.dot(lo);
-    in_front(cx, surface, (normal, base), depth, (blo, bhi), |_| true)
+    let plane = (normal, base);
+    match owner {
+        Owner::Several => true,
+        Owner::Side(side) => {
+            let surface = side / 2;
+            in_front(cx, plane, depth, (blo, bhi), |tri| tri.surface != surface)
+        }
+        Owner::Piece(piece) => in_front(cx, plane, depth, (blo, bhi), |tri| {
+            let side = crate::sampling::side_of(tri.surface, false);
+            cx.pieces.of(side) != Some(piece) && cx.pieces.of(side + 1) != Some(piece)
+        }),
+    }
 }
 
 /// Whether something hovers within `depth` in front of sample `k`, over the disc of its
@@ -215,21 +238,22 @@ pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
     let (lo, hi) = (p - half, p + half);
     let (blo, bhi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
     let base = n.dot(p);
-    in_front(cx, surface, (n, base), depth, (blo, bhi), |tri| {
-        let lowest = tri
-            .vertices
-            .iter()
-            .map(|v| n.dot(*v) - base)
-            .fold(f32::INFINITY, f32::min);
-        lowest > 2.0 * cx.lift
+    in_front(cx, (n, base), depth, (blo, bhi), |tri| {
+        tri.surface != surface && {
+            let lowest = tri
+                .vertices
+                .iter()
+                .map(|v| n.dot(*v) - base)
+                .fold(f32::INFINITY, f32::min);
+            lowest > 2.0 * cx.lift
+        }
     })
 }
 
-/// Whether a triangle of another surface than `surface`, and one that `keep` accepts, has a
-/// part between the lift and `depth` in front of the plane n · x = base, inside the box.
+/// Whether a triangle that `keep` accepts has a part between the lift and `depth` in front of
+/// the plane n · x = base, inside the box.
 fn in_front(
     cx: &Context,
-    surface: u32,
     (n, base): (Vec3, f32),
     depth: f32,
     (lo, hi): (Vec3, Vec3),
@@ -239,7 +263,7 @@ fn in_front(
     let mut scratch: Vec<Vec3> = Vec::with_capacity(9);
     cx.grid.any(lo, hi, |t| {
         let tri = &cx.scene.triangles[t as usize];
-        if tri.surface == surface || !keep(tri) {
+        if !keep(tri) {
             return false;
         }
         poly.clear();

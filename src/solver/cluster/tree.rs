@@ -1,6 +1,7 @@
 //! The cluster tree: a binary tree over the samples (a BVH) whose nodes stand for groups of
 //! samples in the links. The tree is split first by surface side, so every side's samples form
-//! one subtree (one-sided, planar clusters); the sides are then grouped by position and normal
+//! one subtree (one-sided, planar clusters), and a curved piece's samples one (split by place,
+//! each side's group below); the sides and pieces are then grouped by position and normal
 //! above those subtrees. Each node keeps what the links' error bound needs: centroid, bounding
 //! radius, total area, area-weighted normal and normal cone, largest reflectance, the shooting
 //! power its members stand for, and its members as a range of the tree order.
@@ -10,7 +11,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::coherence::{hovered_sample, sheltered, splitter, Context};
+use super::coherence::{hovered_sample, sheltered, splitter, Context, Owner};
 use crate::sampling::{Samples, Side};
 
 /// A reference to a tree node or to a single sample (a leaf).
@@ -162,22 +163,29 @@ impl Tree {
         if n == 0 {
             return tree;
         }
-        // The sides, each with its samples in ascending order.
-        let mut by_side: Vec<(Side, Vec<u32>)> = Vec::new();
+        // The sides, each with its samples in ascending order; a curved piece's sides as one,
+        // so that its samples are grouped by place, not facet by facet (a column's facets are
+        // strips as tall as the column: grouped whole, every node above them was as tall, and
+        // overlapped the floor's and the arches' nodes down to a few samples).
+        let group = |k: u32| {
+            let side = samples.side[k as usize];
+            cx.pieces.of(side).map_or((false, side), |p| (true, p))
+        };
+        let mut by_group: Vec<((bool, u32), Vec<u32>)> = Vec::new();
         {
             let mut ids: Vec<u32> = (0..n as u32).collect();
-            ids.sort_by_key(|&k| (samples.side[k as usize], k));
+            ids.sort_by_key(|&k| (group(k), k));
             for k in ids {
-                let side = samples.side[k as usize];
-                match by_side.last_mut() {
-                    Some((s, list)) if *s == side => list.push(k),
-                    _ => by_side.push((side, vec![k])),
+                let g = group(k);
+                match by_group.last_mut() {
+                    Some((s, list)) if *s == g => list.push(k),
+                    _ => by_group.push((g, vec![k])),
                 }
             }
         }
-        let mut items: Vec<Item> = by_side
+        let mut items: Vec<Item> = by_group
             .into_iter()
-            .map(|(side, members)| Item::new(samples, side, members))
+            .map(|((piece, _), members)| Item::new(samples, piece, members))
             .collect();
         tree.top(samples, cx, &mut items);
         for (place, &k) in tree.order.iter().enumerate() {
@@ -191,27 +199,49 @@ impl Tree {
     }
 
     /// Marks node `i`'s subtree: a node is sheltered when its parent is and something hovers
-    /// within a quarter of its radius in front of it. On a side whose top node is sheltered
-    /// (and under nodes over several sides) each sample is asked too, within its own radius
-    /// (`coherence::hovered_sample`). `top`: whether the parent spans several sides; `hover`:
-    /// whether the parent's samples are asked.
+    /// within a quarter of its radius in front of it. On a side or piece whose top node is
+    /// sheltered (and under nodes over several of them) each sample is asked too, within its
+    /// own radius (`coherence::hovered_sample`). `top`: whether the parent spans several sides
+    /// or pieces; `hover`: whether the parent's samples are asked.
     fn mark_sheltered(&mut self, cx: &Context, i: usize, parent: bool, top: bool, hover: bool) {
         let node = &self.nodes[i];
-        let multi = node.side == MULTI;
-        let here = parent
-            && sheltered(
+        let members = &self.order[node.first as usize..(node.first + node.count) as usize];
+        let owner = if node.side != MULTI {
+            Owner::Side(node.side)
+        } else {
+            let piece = cx.pieces.of(cx.samples.side[members[0] as usize]);
+            match piece {
+                Some(p)
+                    if members
+                        .iter()
+                        .all(|&k| cx.pieces.of(cx.samples.side[k as usize]) == Some(p)) =>
+                {
+                    Owner::Piece(p)
+                }
+                _ => Owner::Several,
+            }
+        };
+        let here = parent && {
+            // The plane through the lowest member's centroid (on its surface).
+            let base = members
+                .iter()
+                .map(|&k| node.axis.dot(cx.samples.centroid[k as usize]))
+                .fold(f32::INFINITY, f32::min);
+            sheltered(
                 cx,
-                (!multi).then_some(node.side),
-                node.axis,
+                owner,
+                (node.axis, base),
                 node.lo,
                 node.hi,
                 0.25 * node.radius,
-            );
+            )
+        };
         self.nodes[i].sheltered = here;
-        let hover = multi || if top { here } else { hover };
+        let several = owner == Owner::Several;
+        let hover = several || if top { here } else { hover };
         for c in self.nodes[i].children {
             if !c.is_leaf() {
-                self.mark_sheltered(cx, c.index(), here, multi, hover);
+                self.mark_sheltered(cx, c.index(), here, several, hover);
             } else if hover {
                 let k = c.index();
                 self.leaf[k].hovered = hovered_sample(cx, k, cx.samples.radius[k]);
@@ -303,7 +333,7 @@ impl Tree {
         out
     }
 
-    /// Groups of sides, split by position and normal until one side is left, then that side's
+    /// Groups of sides and pieces, split by position and normal until one is left, then its
     /// subtree. Returns the new subtree's root.
     fn top(&mut self, samples: &Samples, cx: &Context, items: &mut [Item]) -> (Ref, u32) {
         if items.len() == 1 {
@@ -311,7 +341,7 @@ impl Tree {
             let start = self.order.len();
             self.order.extend_from_slice(&members);
             let end = self.order.len();
-            return self.side_tree(samples, cx, items[0].side, start, end, false);
+            return self.subtree(samples, cx, (start, end), items[0].piece, false);
         }
         let index = self.placeholder();
         // Positions and normals scaled by the group's size, so that sides facing different
@@ -367,16 +397,17 @@ impl Tree {
         (Ref::node(index), a.1)
     }
 
-    /// The subtree over `order[start..end]` (one side): a group with something standing among
-    /// its members is split along that occluder's plane; a coherent group (whose subsets are all
-    /// coherent: `coherent`) at the median of its longer extent.
-    fn side_tree(
+    /// The subtree over `order[start..end]`, the samples of one side or of one curved piece
+    /// (`piece`: on several of its sides; a group of them on one side goes on as that side's): a
+    /// group with something standing among its members is split along that occluder's plane; a
+    /// coherent group (whose subsets are all coherent: `coherent`) at the median of its longer
+    /// extent.
+    fn subtree(
         &mut self,
         samples: &Samples,
         cx: &Context,
-        side: Side,
-        start: usize,
-        end: usize,
+        (start, end): (usize, usize),
+        piece: bool,
         coherent: bool,
     ) -> (Ref, u32) {
         if end - start == 1 {
@@ -384,6 +415,8 @@ impl Tree {
         }
         let index = self.placeholder();
         let members = &mut self.order[start..end];
+        let side = samples.side[members[0] as usize];
+        let piece = piece && members.iter().any(|&k| samples.side[k as usize] != side);
         let (lo, hi) = members.iter().fold(
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(lo, hi), &k| {
@@ -394,7 +427,7 @@ impl Tree {
         let occluder = if coherent {
             None
         } else {
-            splitter(cx, Some(side), members, lo, hi)
+            splitter(cx, (!piece).then_some(side), members, lo, hi)
         };
         let mid = match occluder {
             Some(plane) => {
@@ -417,8 +450,8 @@ impl Tree {
             }
         };
         let coherent = occluder.is_none();
-        let a = self.side_tree(samples, cx, side, start, start + mid, coherent);
-        let b = self.side_tree(samples, cx, side, start + mid, end, coherent);
+        let a = self.subtree(samples, cx, (start, start + mid), piece, coherent);
+        let b = self.subtree(samples, cx, (start + mid, end), piece, coherent);
         self.fill(samples, index, [a, b]);
         self.nodes[index as usize].coherent = coherent;
         (Ref::node(index), start as u32)
@@ -607,9 +640,12 @@ impl Tree {
     }
 }
 
-/// A side as the top of the tree sees it.
+/// A side, or a curved piece, as the top of the tree sees it.
 struct Item {
+    /// The side of the first member.
     side: Side,
+    /// Whether the members are a curved piece's.
+    piece: bool,
     members: Vec<u32>,
     centre: Vec3,
     normal: Vec3,
@@ -618,7 +654,8 @@ struct Item {
 }
 
 impl Item {
-    fn new(samples: &Samples, side: Side, members: Vec<u32>) -> Item {
+    fn new(samples: &Samples, piece: bool, members: Vec<u32>) -> Item {
+        let side = samples.side[members[0] as usize];
         let (lo, hi) = members.iter().fold(
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(lo, hi), &k| {
@@ -629,6 +666,7 @@ impl Item {
         let normal = samples.normal[members[0] as usize];
         Item {
             side,
+            piece,
             members,
             centre: 0.5 * (lo + hi),
             normal,
