@@ -394,7 +394,7 @@ fn on_artist_made_facets_the_hierarchy_matches_the_flat_solve_sample_by_sample()
     // The atrium: columns of 48 facets, arches, vaults, cloths, most surfaces under 0.5 m², so
     // most nodes span several surfaces with something standing among their members. Both
     // solvers on the same samples (no adaptive rounds): the flat solver is the independent
-    // O(N²) transport: 0.15% apart on average, bias -0.02% (measured). Links: 516 a sample;
+    // O(N²) transport: 0.15% apart on average, bias -0.02% (measured). Links: 515 a sample;
     // 662 when larger pairs with something standing among their members were refined however
     // faint, 1,090 when small ones were refined to samples too, and a partly visible pair whose
     // every member pair was probed gave a leaf link for each visible member pair.

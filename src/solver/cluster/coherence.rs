@@ -31,6 +31,8 @@ pub(crate) struct TriangleGrid {
     dims: IVec3,
     starts: Vec<u32>,
     entries: Vec<u32>,
+    /// How many triangles the scene has.
+    triangles: usize,
 }
 
 impl TriangleGrid {
@@ -45,6 +47,7 @@ impl TriangleGrid {
             dims,
             starts: Vec::new(),
             entries: Vec::new(),
+            triangles: scene.triangles.len(),
         };
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         for (i, t) in scene.triangles.iter().enumerate() {
@@ -82,21 +85,46 @@ impl TriangleGrid {
         }
     }
 
-    /// Whether `test` holds for some triangle whose grid cells meet the box [lo, hi] (a
-    /// triangle may be tested more than once).
+    /// Whether `test` holds for some triangle whose grid cells meet the box [lo, hi], each
+    /// tested once, in grid order. A triangle at a slant to the axes lies in many cells, and a
+    /// box of such triangles (a sloping side's node) meets it in many: tested once per cell,
+    /// a member-by-member test ran hundreds of times over.
     fn any(&self, lo: Vec3, hi: Vec3, mut test: impl FnMut(u32) -> bool) -> bool {
-        let (a, b) = (self.key(lo), self.key(hi));
-        for z in a.z..=b.z {
-            for y in a.y..=b.y {
-                let row = ((z * self.dims.y + y) * self.dims.x) as usize;
-                let range: Range<usize> = self.starts[row + a.x as usize] as usize
-                    ..self.starts[row + b.x as usize + 1] as usize;
-                if self.entries[range].iter().any(|&t| test(t)) {
-                    return true;
+        thread_local! {
+            /// Per triangle, the last query that tested it; and the query count.
+            static TESTED: std::cell::RefCell<(Vec<u32>, u32)> =
+                const { std::cell::RefCell::new((Vec::new(), 0)) };
+        }
+        TESTED.with(|tested| {
+            let mut guard = tested.borrow_mut();
+            let (stamps, query) = &mut *guard;
+            if stamps.len() < self.triangles {
+                stamps.resize(self.triangles, 0);
+            }
+            *query = query.wrapping_add(1);
+            if *query == 0 {
+                // Wrapped: no stamp may match a new query by accident.
+                stamps.fill(0);
+                *query = 1;
+            }
+            let (a, b) = (self.key(lo), self.key(hi));
+            for z in a.z..=b.z {
+                for y in a.y..=b.y {
+                    let row = ((z * self.dims.y + y) * self.dims.x) as usize;
+                    let range: Range<usize> = self.starts[row + a.x as usize] as usize
+                        ..self.starts[row + b.x as usize + 1] as usize;
+                    for &t in &self.entries[range] {
+                        if stamps[t as usize] != *query {
+                            stamps[t as usize] = *query;
+                            if test(t) {
+                                return true;
+                            }
+                        }
+                    }
                 }
             }
-        }
-        false
+            false
+        })
     }
 }
 
@@ -191,36 +219,85 @@ pub(crate) enum Owner {
     Several,
 }
 
+/// Where a node's members lie: the world's box of their points, their bounds along two axes in
+/// its plane (its surface's own, which follow an edge of it), and the plane through the lowest
+/// of them. The world's box alone is loose for a side at a slant to the axes: it holds the
+/// walls the side meets, which were taken for things hovering in front of it (`cornell` turned
+/// at a slant had four times the sheltered nodes and twice the links).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Footprint {
+    normal: Vec3,
+    world: (Vec3, Vec3),
+    axes: [Vec3; 2],
+    lo: [f32; 2],
+    hi: [f32; 2],
+    base: f32,
+}
+
+impl Footprint {
+    /// The footprint of `members` (their sample points and centroids) under `normal` (unit),
+    /// measured along `along` (a direction in the plane) and across it.
+    pub(crate) fn of(samples: &Samples, normal: Vec3, along: Vec3, members: &[u32]) -> Footprint {
+        let first = (along - normal * normal.dot(along))
+            .try_normalize()
+            .unwrap_or_else(|| normal.any_orthonormal_vector());
+        let axes = [first, normal.cross(first)];
+        let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
+        let mut world = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        let mut base = f32::INFINITY;
+        for &k in members {
+            let (p, c) = (samples.position[k as usize], samples.centroid[k as usize]);
+            for q in [p, c] {
+                world = (world.0.min(q), world.1.max(q));
+                for (i, axis) in axes.iter().enumerate() {
+                    lo[i] = lo[i].min(axis.dot(q));
+                    hi[i] = hi[i].max(axis.dot(q));
+                }
+            }
+            base = base.min(normal.dot(c));
+        }
+        Footprint {
+            normal,
+            world,
+            axes,
+            lo,
+            hi,
+            base,
+        }
+    }
+}
+
 /// Whether something hovers close in front of the members of a node on one side or one curved
-/// piece (within `depth` in front of the plane n · x = `base` through its lowest member, over
-/// their footprint): a light fixture under a ceiling, a canvas before a wall. Such a node may
+/// piece (between the lift and `depth` in front of the plane through its lowest member, over
+/// their footprint shrunk by the lift: a wall meeting the side along the footprint's edge does
+/// not shelter it): a light fixture under a ceiling, a canvas before a wall. Such a node may
 /// hold members that see a shooter and members sheltered from it, in a gap the probes of a faint
 /// link can miss; light is never averaged into it. A piece's own facets do not count (a vault's
 /// curve rises in front of its lowest member). Nodes over several sides of more than one
 /// surface or piece count as sheltered.
-pub(crate) fn sheltered(
-    cx: &Context,
-    owner: Owner,
-    (normal, base): (Vec3, f32),
-    lo: Vec3,
-    hi: Vec3,
-    depth: f32,
-) -> bool {
-    // The members' box, shrunk across the plane by the lift (a wall meeting the side along the
-    // footprint's edge does not shelter it), and reaching `depth` in front.
-    let pad = Vec3::splat(cx.lift) * (Vec3::ONE - normal.abs());
-    let (blo, bhi) = (
-        (lo + pad).min(lo + pad + depth * normal),
-        (hi - pad).max(hi - pad + depth * normal),
-    );
-    let plane = (normal, base);
+pub(crate) fn sheltered(cx: &Context, owner: Owner, at: &Footprint, depth: f32) -> bool {
+    let n = at.normal;
+    // The slab in front; the world's box of the members, shrunk across the plane by the lift
+    // and reaching `depth` in front; and their bounds in the plane's frame, shrunk by the lift.
+    let pad = Vec3::splat(cx.lift) * (Vec3::ONE - n.abs());
+    let (lo, hi) = (at.world.0 + pad, at.world.1 - pad);
+    let (lo, hi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
+    let mut planes = vec![(n, at.base + cx.lift), (-n, -(at.base + depth))];
+    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+        planes.push((axis, axis.dot(lo)));
+        planes.push((-axis, -axis.dot(hi)));
+    }
+    for i in 0..2 {
+        planes.push((at.axes[i], at.lo[i] + cx.lift));
+        planes.push((-at.axes[i], -(at.hi[i] - cx.lift)));
+    }
     match owner {
         Owner::Several => true,
         Owner::Side(side) => {
             let surface = side / 2;
-            in_front(cx, plane, depth, (blo, bhi), |tri| tri.surface != surface)
+            in_front(cx, (lo, hi), &planes, |tri| tri.surface != surface)
         }
-        Owner::Piece(piece) => in_front(cx, plane, depth, (blo, bhi), |tri| {
+        Owner::Piece(piece) => in_front(cx, (lo, hi), &planes, |tri| {
             let side = crate::sampling::side_of(tri.surface, false);
             cx.pieces.of(side) != Some(piece) && cx.pieces.of(side + 1) != Some(piece)
         }),
@@ -238,7 +315,12 @@ pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
     let (lo, hi) = (p - half, p + half);
     let (blo, bhi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
     let base = n.dot(p);
-    in_front(cx, (n, base), depth, (blo, bhi), |tri| {
+    let mut planes = vec![(n, base + cx.lift), (-n, -(base + depth))];
+    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+        planes.push((axis, axis.dot(blo)));
+        planes.push((-axis, -axis.dot(bhi)));
+    }
+    in_front(cx, (blo, bhi), &planes, |tri| {
         tri.surface != surface && {
             let lowest = tri
                 .vertices
@@ -250,13 +332,12 @@ pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
     })
 }
 
-/// Whether a triangle that `keep` accepts has a part between the lift and `depth` in front of
-/// the plane n · x = base, inside the box.
+/// Whether a triangle among those the grid holds in the box [lo, hi], and one that `keep`
+/// accepts, has a part inside every half-space n · x ≥ c of `planes`.
 fn in_front(
     cx: &Context,
-    (n, base): (Vec3, f32),
-    depth: f32,
     (lo, hi): (Vec3, Vec3),
+    planes: &[(Vec3, f32)],
     keep: impl Fn(&crate::scene::Triangle) -> bool,
 ) -> bool {
     let mut poly: Vec<Vec3> = Vec::with_capacity(9);
@@ -268,9 +349,9 @@ fn in_front(
         }
         poly.clear();
         poly.extend_from_slice(&tri.vertices);
-        clip_half_space(&mut poly, &mut scratch, n, base + cx.lift);
-        clip_half_space(&mut poly, &mut scratch, -n, -(base + depth));
-        clip_box(&mut poly, &mut scratch, lo, hi);
+        for &(n, c) in planes {
+            clip_half_space(&mut poly, &mut scratch, n, c);
+        }
         !poly.is_empty()
     })
 }
@@ -293,16 +374,6 @@ fn meets_box(t: &[Vec3; 3], lo: Vec3, hi: Vec3) -> bool {
         }
     }
     true
-}
-
-/// Clips a convex polygon to an axis-aligned box.
-fn clip_box(poly: &mut Vec<Vec3>, scratch: &mut Vec<Vec3>, lo: Vec3, hi: Vec3) {
-    for axis in 0..3 {
-        let mut n = Vec3::ZERO;
-        n[axis] = 1.0;
-        clip_half_space(poly, scratch, n, lo[axis]);
-        clip_half_space(poly, scratch, -n, -hi[axis]);
-    }
 }
 
 /// Clips a convex polygon to the half-space n·x ≥ c (closed, so a polygon touching the plane

@@ -11,8 +11,8 @@
 
 use glam::{DVec3, Vec3};
 
-use super::coherence::{hovered_sample, sheltered, splitter, Context, Owner};
-use crate::sampling::{Samples, Side};
+use super::coherence::{hovered_sample, sheltered, splitter, Context, Footprint, Owner};
+use crate::sampling::{surface_of, Samples, Side};
 
 /// A reference to a tree node or to a single sample (a leaf).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -221,21 +221,15 @@ impl Tree {
                 _ => Owner::Several,
             }
         };
-        let here = parent && {
-            // The plane through the lowest member's centroid (on its surface).
-            let base = members
-                .iter()
-                .map(|&k| node.axis.dot(cx.samples.centroid[k as usize]))
-                .fold(f32::INFINITY, f32::min);
-            sheltered(
-                cx,
-                owner,
-                (node.axis, base),
-                node.lo,
-                node.hi,
-                0.25 * node.radius,
-            )
-        };
+        let here = parent
+            && (owner == Owner::Several || {
+                // Along the first edge of the first member's surface (its map's first axis).
+                let surface =
+                    &cx.scene.surfaces[surface_of(cx.samples.side[members[0] as usize]) as usize];
+                let [a, b, _] = cx.scene.triangles[surface.triangles.start as usize].vertices;
+                let at = Footprint::of(cx.samples, node.axis, b - a, members);
+                sheltered(cx, owner, &at, 0.25 * node.radius)
+            });
         self.nodes[i].sheltered = here;
         let several = owner == Owner::Several;
         let hover = several || if top { here } else { hover };
