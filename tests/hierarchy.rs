@@ -448,5 +448,11 @@ fn on_artist_made_facets_the_hierarchy_matches_the_flat_solve_sample_by_sample()
             "{backend}: {:.0} links a sample",
             links / n
         );
+        // Joined, grouped by place: 287 a sample grouped facet by facet.
+        assert!(
+            !join_facets || links / n < 283.0,
+            "{backend}: {:.0} links a sample joined",
+            links / n
+        );
     }
 }

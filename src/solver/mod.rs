@@ -795,14 +795,17 @@ mod tests {
         assert!(broken.validate(&s.field.samples).is_err());
     }
 
-    /// `cornell` with every vertex turned by `turn` (its files written to `dir`).
-    fn turned_cornell(turn: glam::Quat, dir: &std::path::Path) -> Scene {
+    /// `cornell` with every vertex turned by `turn` (its files written to `dir`), and a round
+    /// column of `facets` facets (radius 0.25 m, floor to ceiling, in the back right corner)
+    /// if `facets` > 0.
+    fn turned_cornell(turn: glam::Quat, facets: u32, dir: &std::path::Path) -> Scene {
         let from = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell");
         for file in ["cornell.mtl", "scene.toml"] {
             std::fs::copy(from.join(file), dir.join(file)).unwrap();
         }
-        let obj: String = std::fs::read_to_string(from.join("cornell.obj"))
-            .unwrap()
+        let text = std::fs::read_to_string(from.join("cornell.obj")).unwrap();
+        let count = text.lines().filter(|l| l.starts_with("v ")).count();
+        let mut obj: String = text
             .lines()
             .map(|line| match line.strip_prefix("v ") {
                 Some(xyz) => {
@@ -813,20 +816,36 @@ mod tests {
                 None => format!("{line}\n"),
             })
             .collect();
+        if facets > 0 {
+            obj += "usemtl white\n";
+            for i in 0..facets {
+                let a = std::f32::consts::TAU * i as f32 / facets as f32;
+                let (x, z) = (3.3 + 0.25 * a.cos(), 3.3 + 0.25 * a.sin());
+                for y in [0.0, 3.0] {
+                    let p = turn * glam::Vec3::new(x, y, z);
+                    obj += &format!("v {} {} {}\n", p.x, p.y, p.z);
+                }
+            }
+            for i in 0..facets {
+                // Bottom and top of this edge and the next, facing out.
+                let (b0, t0) = (count + 2 * i as usize + 1, count + 2 * i as usize + 2);
+                let j = (i + 1) % facets;
+                let (b1, t1) = (count + 2 * j as usize + 1, count + 2 * j as usize + 2);
+                obj += &format!("f {b0} {t0} {t1} {b1}\n");
+            }
+        }
         std::fs::write(dir.join("cornell.obj"), obj).unwrap();
         Scene::load(dir.join("scene.toml")).unwrap()
     }
 
     #[test]
     fn a_curved_piece_is_one_subtree_grouped_by_place() {
-        // The diffuse spheres joined: each sphere's facets make pieces of several sides. A
+        // `cornell` with a round column of 48 facets 3.3 cm wide and 3 m tall, joined: its
+        // facets make pieces of several sides, each side a strip holding several samples. A
         // piece's samples are one node's members (its subtree), and below it nodes span several
-        // of its sides (grouped by place, not facet by facet) down to groups on one side.
-        let scene = Scene::load(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("scenes/cornell-spheres/diffuse-spheres.toml"),
-        )
-        .unwrap();
+        // of its sides, holding part of one (grouped by place, not facet by facet).
+        let dir = tempfile::tempdir().unwrap();
+        let scene = turned_cornell(glam::Quat::IDENTITY, 48, dir.path());
         let (s, tree) = solve_and_tree(&scene, 0, true);
         assert_eq!(tree.validate(&s.field.samples), Ok(()));
         let pieces = s.field.layout.pieces();
@@ -837,7 +856,7 @@ mod tests {
                 members.entry(p).or_default().push(k);
             }
         }
-        let (mut several, mut across) = (0, 0);
+        let (mut several, mut across, mut by_place) = (0, 0, 0);
         for (p, ks) in &members {
             let sides: std::collections::BTreeSet<u32> = ks
                 .iter()
@@ -859,18 +878,33 @@ mod tests {
                 .iter()
                 .find(|n| n.first == first && n.count as usize == ks.len());
             assert!(node.is_some(), "no node holds piece {p} alone");
-            across += tree
-                .nodes
-                .iter()
-                .filter(|n| {
-                    n.first >= first
-                        && n.first + n.count <= last + 1
-                        && (n.count as usize) < ks.len()
-                        && n.side == cluster::tree::MULTI
-                })
-                .count();
+            for n in tree.nodes.iter().filter(|n| {
+                n.first >= first
+                    && n.first + n.count <= last + 1
+                    && (n.count as usize) < ks.len()
+                    && n.side == cluster::tree::MULTI
+            }) {
+                across += 1;
+                // Grouped by place, a node cuts across its sides: it holds part of one of
+                // them (facet by facet, every node held whole sides).
+                let members = &tree.order[n.first as usize..(n.first + n.count) as usize];
+                let side_of = |k: u32| s.field.samples.side[k as usize];
+                let part = members.iter().any(|&m| {
+                    let held = members
+                        .iter()
+                        .filter(|&&j| side_of(j) == side_of(m))
+                        .count();
+                    let all = ks.iter().filter(|&&j| side_of(j) == side_of(m)).count();
+                    held < all
+                });
+                by_place += usize::from(part);
+            }
         }
         assert!(several > 10, "{several} pieces over several sides");
+        assert!(
+            by_place > several,
+            "{by_place} nodes holding part of a side"
+        );
         assert!(
             across > several,
             "{across} nodes over several sides within pieces"
@@ -902,7 +936,7 @@ mod tests {
             glam::Quat::from_axis_angle(glam::Vec3::new(1.0, 0.0, 1.0).normalize(), 0.7),
             glam::Quat::from_rotation_y(30f32.to_radians()),
         ] {
-            let (t, _) = solve_and_tree(&turned_cornell(turn, dir.path()), 0, false);
+            let (t, _) = solve_and_tree(&turned_cornell(turn, 0, dir.path()), 0, false);
             let ratio = t.rounds()[0].shooting.links as f64 / links;
             let change = reflected(&t) / light - 1.0;
             eprintln!("{turn}: links {ratio:.3} x the upright room's, light {change:+.4}");
@@ -930,7 +964,7 @@ mod tests {
                 )
                 .unwrap(),
             ),
-            (turn, turned_cornell(turn, dir.path())),
+            (turn, turned_cornell(turn, 0, dir.path())),
         ] {
             let (s, tree) = solve_and_tree(&scene, 0, false);
             let n = s.field.samples.len();

@@ -10,8 +10,8 @@
 //!
 //! Incoherent nodes are split, and linked only in pairs of so few member pairs that every pair
 //! is probed (then nothing can hide behind the occluder); single samples are always coherent. The
-//! tree splits a side's incoherent node along the plane of the triangle standing among its
-//! members (as a BSP would), so that an occluder costs a few incoherent nodes, not every node
+//! tree splits a side's (or a curved piece's) incoherent node along the plane of the triangle
+//! standing among its members (as a BSP would), so that an occluder costs a few incoherent nodes, not every node
 //! its outline crosses.
 //! Occluders that merely hover between a node and a shooter are what the link's rays are for;
 //! one hovering close in front of a node (`sheltered`, `hovered_sample`) makes its members see
@@ -88,7 +88,8 @@ impl TriangleGrid {
     /// Whether `test` holds for some triangle whose grid cells meet the box [lo, hi], each
     /// tested once, in grid order. A triangle at a slant to the axes lies in many cells, and a
     /// box of such triangles (a sloping side's node) meets it in many: tested once per cell,
-    /// a member-by-member test ran hundreds of times over.
+    /// a member-by-member test ran hundreds of times over. `test` must not query the grid
+    /// itself (the stamps are borrowed for the query).
     fn any(&self, lo: Vec3, hi: Vec3, mut test: impl FnMut(u32) -> bool) -> bool {
         thread_local! {
             /// Per triangle, the last query that tested it; and the query count.
@@ -220,10 +221,11 @@ pub(crate) enum Owner {
 }
 
 /// Where a node's members lie: the world's box of their points, their bounds along two axes in
-/// its plane (its surface's own, which follow an edge of it), and the plane through the lowest
-/// of them. The world's box alone is loose for a side at a slant to the axes: it holds the
+/// its plane (its surface's own, which follow an edge of it; where that edge is a diagonal the
+/// two boxes cut an octagon, tighter than either), and the plane through the lowest of their
+/// centroids. The world's box alone is loose for a side at a slant to the axes: it holds the
 /// walls the side meets, which were taken for things hovering in front of it (`cornell` turned
-/// at a slant had four times the sheltered nodes and twice the links).
+/// at a slant, rendered: 1.69 times the upright room's links, now 1.19).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Footprint {
     normal: Vec3,
@@ -268,7 +270,7 @@ impl Footprint {
 }
 
 /// Whether something hovers close in front of the members of a node on one side or one curved
-/// piece (between the lift and `depth` in front of the plane through its lowest member, over
+/// piece (between the lift and `depth` in front of the plane through its lowest centroid, over
 /// their footprint shrunk by the lift: a wall meeting the side along the footprint's edge does
 /// not shelter it): a light fixture under a ceiling, a canvas before a wall. Such a node may
 /// hold members that see a shooter and members sheltered from it, in a gap the probes of a faint
@@ -282,15 +284,21 @@ pub(crate) fn sheltered(cx: &Context, owner: Owner, at: &Footprint, depth: f32) 
     let pad = Vec3::splat(cx.lift) * (Vec3::ONE - n.abs());
     let (lo, hi) = (at.world.0 + pad, at.world.1 - pad);
     let (lo, hi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
-    let mut planes = vec![(n, at.base + cx.lift), (-n, -(at.base + depth))];
-    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
-        planes.push((axis, axis.dot(lo)));
-        planes.push((-axis, -axis.dot(hi)));
-    }
-    for i in 0..2 {
-        planes.push((at.axes[i], at.lo[i] + cx.lift));
-        planes.push((-at.axes[i], -(at.hi[i] - cx.lift)));
-    }
+    let [u, v] = at.axes;
+    let planes = [
+        (n, at.base + cx.lift),
+        (-n, -(at.base + depth)),
+        (Vec3::X, lo.x),
+        (-Vec3::X, -hi.x),
+        (Vec3::Y, lo.y),
+        (-Vec3::Y, -hi.y),
+        (Vec3::Z, lo.z),
+        (-Vec3::Z, -hi.z),
+        (u, at.lo[0] + cx.lift),
+        (-u, -(at.hi[0] - cx.lift)),
+        (v, at.lo[1] + cx.lift),
+        (-v, -(at.hi[1] - cx.lift)),
+    ];
     match owner {
         Owner::Several => true,
         Owner::Side(side) => {
@@ -315,11 +323,16 @@ pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
     let (lo, hi) = (p - half, p + half);
     let (blo, bhi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
     let base = n.dot(p);
-    let mut planes = vec![(n, base + cx.lift), (-n, -(base + depth))];
-    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
-        planes.push((axis, axis.dot(blo)));
-        planes.push((-axis, -axis.dot(bhi)));
-    }
+    let planes = [
+        (n, base + cx.lift),
+        (-n, -(base + depth)),
+        (Vec3::X, blo.x),
+        (-Vec3::X, -bhi.x),
+        (Vec3::Y, blo.y),
+        (-Vec3::Y, -bhi.y),
+        (Vec3::Z, blo.z),
+        (-Vec3::Z, -bhi.z),
+    ];
     in_front(cx, (blo, bhi), &planes, |tri| {
         tri.surface != surface && {
             let lowest = tri

@@ -357,8 +357,8 @@ impl Linker<'_> {
 
     /// Whether something hovers close in front of `node` and its probes cannot vouch for it: a
     /// sample (see `LeafData::hovered`), or a sheltered node on one side of at most
-    /// [`HOVERED_MEMBERS`] members (a node over several sides is sheltered unless they are a
-    /// curved piece's, but its probes span the sides).
+    /// [`HOVERED_MEMBERS`] members (nodes over several sides, a curved piece's too, are left
+    /// out: their probes span the sides).
     fn hovered(&self, node: Ref) -> bool {
         if node.is_leaf() {
             self.tree.leaf[node.index()].hovered
