@@ -11,8 +11,8 @@
 //! Incoherent nodes are split, and linked only in pairs of so few member pairs that every pair
 //! is probed (then nothing can hide behind the occluder); single samples are always coherent. The
 //! tree splits a side's (or a curved piece's) incoherent node along the plane of the triangle
-//! standing among its members (as a BSP would), so that an occluder costs a few incoherent nodes, not every node
-//! its outline crosses.
+//! standing among its members (as a BSP would), so that an occluder costs a few incoherent
+//! nodes, not every node its outline crosses.
 //! Occluders that merely hover between a node and a shooter are what the link's rays are for;
 //! one hovering close in front of a node (`sheltered`, `hovered_sample`) makes its members see
 //! differently, so the links refine such nodes rather than trust a few rays.
