@@ -795,6 +795,12 @@ mod tests {
         assert!(broken.validate(&s.field.samples).is_err());
     }
 
+    /// `cornell` at a slant: turned 0.7 rad about (1, 0, 1), its ceiling's normal leaning along
+    /// x and z both.
+    fn slant() -> glam::Quat {
+        glam::Quat::from_axis_angle(glam::Vec3::new(1.0, 0.0, 1.0).normalize(), 0.7)
+    }
+
     /// `cornell` with every vertex turned by `turn` (its files written to `dir`), and a round
     /// column of `facets` facets (radius 0.25 m, floor to ceiling, in the back right corner)
     /// if `facets` > 0.
@@ -920,10 +926,7 @@ mod tests {
         // world's boxes alone). Now 1.18 and 1.07 times; the light reflected the same within
         // 0.1% (measured).
         let dir = tempfile::tempdir().unwrap();
-        let upright = Scene::load(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell/scene.toml"),
-        )
-        .unwrap();
+        let upright = turned_cornell(glam::Quat::IDENTITY, 0, dir.path());
         let (s, _) = solve_and_tree(&upright, 0, false);
         let reflected = |s: &Solution| -> f64 {
             let samples = &s.field.samples;
@@ -932,10 +935,7 @@ mod tests {
                 .sum()
         };
         let (links, light) = (s.rounds()[0].shooting.links as f64, reflected(&s));
-        for turn in [
-            glam::Quat::from_axis_angle(glam::Vec3::new(1.0, 0.0, 1.0).normalize(), 0.7),
-            glam::Quat::from_rotation_y(30f32.to_radians()),
-        ] {
+        for turn in [slant(), glam::Quat::from_rotation_y(30f32.to_radians())] {
             let (t, _) = solve_and_tree(&turned_cornell(turn, 0, dir.path()), 0, false);
             let ratio = t.rounds()[0].shooting.links as f64 / links;
             let change = reflected(&t) / light - 1.0;
@@ -954,19 +954,8 @@ mod tests {
         // sloping ceiling whose normal leans along x and z both): the same samples, but for
         // those whose box, boxed again along the turned axes, may reach the square or not.
         let dir = tempfile::tempdir().unwrap();
-        let turn = glam::Quat::from_axis_angle(glam::Vec3::new(1.0, 0.0, 1.0).normalize(), 0.7);
-        for (turn, scene) in [
-            (
-                glam::Quat::IDENTITY,
-                Scene::load(
-                    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                        .join("scenes/cornell/scene.toml"),
-                )
-                .unwrap(),
-            ),
-            (turn, turned_cornell(turn, 0, dir.path())),
-        ] {
-            let (s, tree) = solve_and_tree(&scene, 0, false);
+        for turn in [glam::Quat::IDENTITY, slant()] {
+            let (s, tree) = solve_and_tree(&turned_cornell(turn, 0, dir.path()), 0, false);
             let n = s.field.samples.len();
             let (mut hovered, mut checked) = (0, 0);
             let upright = turn == glam::Quat::IDENTITY;

@@ -288,12 +288,6 @@ pub(crate) fn sheltered(cx: &Context, owner: Owner, at: &Footprint, depth: f32) 
     let planes = [
         (n, at.base + cx.lift),
         (-n, -(at.base + depth)),
-        (Vec3::X, lo.x),
-        (-Vec3::X, -hi.x),
-        (Vec3::Y, lo.y),
-        (-Vec3::Y, -hi.y),
-        (Vec3::Z, lo.z),
-        (-Vec3::Z, -hi.z),
         (u, at.lo[0] + cx.lift),
         (-u, -(at.hi[0] - cx.lift)),
         (v, at.lo[1] + cx.lift),
@@ -323,17 +317,8 @@ pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
     let (lo, hi) = (p - half, p + half);
     let (blo, bhi) = (lo.min(lo + depth * n), hi.max(hi + depth * n));
     let base = n.dot(p);
-    let planes = [
-        (n, base + cx.lift),
-        (-n, -(base + depth)),
-        (Vec3::X, blo.x),
-        (-Vec3::X, -bhi.x),
-        (Vec3::Y, blo.y),
-        (-Vec3::Y, -bhi.y),
-        (Vec3::Z, blo.z),
-        (-Vec3::Z, -bhi.z),
-    ];
-    in_front(cx, (blo, bhi), &planes, |tri| {
+    let slab = [(n, base + cx.lift), (-n, -(base + depth))];
+    in_front(cx, (blo, bhi), &slab, |tri| {
         tri.surface != surface && {
             let lowest = tri
                 .vertices
@@ -345,8 +330,8 @@ pub(crate) fn hovered_sample(cx: &Context, k: usize, depth: f32) -> bool {
     })
 }
 
-/// Whether a triangle among those the grid holds in the box [lo, hi], and one that `keep`
-/// accepts, has a part inside every half-space n · x ≥ c of `planes`.
+/// Whether a triangle that `keep` accepts has a part inside every half-space n · x ≥ c of
+/// `planes` and inside the box [lo, hi].
 fn in_front(
     cx: &Context,
     (lo, hi): (Vec3, Vec3),
@@ -365,7 +350,7 @@ fn in_front(
         for &(n, c) in planes {
             clip_half_space(&mut poly, &mut scratch, n, c);
         }
-        !poly.is_empty()
+        clip_box(&mut poly, &mut scratch, lo, hi)
     })
 }
 
@@ -376,12 +361,16 @@ fn meets_box(t: &[Vec3; 3], lo: Vec3, hi: Vec3) -> bool {
         return false;
     }
     let mut poly: Vec<Vec3> = t.to_vec();
-    let mut scratch = Vec::with_capacity(9);
+    clip_box(&mut poly, &mut Vec::with_capacity(9), lo, hi)
+}
+
+/// Clips a convex polygon to an axis-aligned box; whether something is left.
+fn clip_box(poly: &mut Vec<Vec3>, scratch: &mut Vec<Vec3>, lo: Vec3, hi: Vec3) -> bool {
     for axis in 0..3 {
         let mut n = Vec3::ZERO;
         n[axis] = 1.0;
-        clip_half_space(&mut poly, &mut scratch, n, lo[axis]);
-        clip_half_space(&mut poly, &mut scratch, -n, -hi[axis]);
+        clip_half_space(poly, scratch, n, lo[axis]);
+        clip_half_space(poly, scratch, -n, -hi[axis]);
         if poly.is_empty() {
             return false;
         }
